@@ -1,0 +1,41 @@
+# The two commands a student or instructor needs are `make lab` and `make test`.
+# Both create .venv on first use and re-install only when pyproject.toml or
+# constraints.txt changed, so a second run starts at once.
+
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+# Exact versions CI tested (Python 3.11). Run `make CONSTRAINTS= test` to install
+# from the lower bounds in pyproject.toml instead (e.g. on another Python).
+CONSTRAINTS ?= constraints.txt
+CONSTRAINT_FLAG := $(if $(CONSTRAINTS),-c $(CONSTRAINTS),)
+STAMP := $(VENV)/.installed
+PYTEST_ARGS ?=
+
+.PHONY: lab test lint notebooks clean
+
+$(BIN)/python:
+	$(PYTHON) -m venv $(VENV)
+
+$(STAMP): pyproject.toml $(CONSTRAINTS) | $(BIN)/python
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet $(CONSTRAINT_FLAG) -e '.[test]'
+	touch $(STAMP)
+
+lab: $(STAMP)
+	$(BIN)/jupyter lab notebooks/
+
+lint: $(STAMP)
+	$(BIN)/ruff check lqe_helpers tests benchmarks notebooks
+
+# Every test: ruff, the unit tests and nbval over every notebook.
+test: $(STAMP) lint
+	$(BIN)/python -m pytest tests --nbval notebooks --nbval-current-env $(PYTEST_ARGS)
+
+# Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
+notebooks: $(STAMP)
+	$(BIN)/python -m lqe_helpers.notebook_runner notebooks/*.ipynb
+
+clean:
+	rm -rf $(VENV) build .pytest_cache .ruff_cache .hypothesis lqe_course_pack.egg-info
+	find . -name __pycache__ -type d -prune -exec rm -rf {} +

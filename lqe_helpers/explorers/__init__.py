@@ -1,0 +1,1 @@
+"""One interactive explorer per notebook, each built on a plain drawing function."""

@@ -1,0 +1,200 @@
+"""Numbers the notebooks report: MSE, Monte Carlo intervals, convergence time."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import validation
+
+# Two-sided 95 % Student-t critical values t(0.975, df) for df = 1 … 30.
+_T975 = (12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622, 2.2281,
+         2.2010, 2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860,
+         2.0796, 2.0739, 2.0687, 2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423)
+_Z975 = 1.959963984540054
+
+
+def t_critical_95(df: int) -> float:
+    """Two-sided 95 % critical value of Student's t with ``df`` degrees of freedom.
+
+    Exact (4 decimals) for df <= 30; above, the Cornish–Fisher expansion around the
+    normal quantile, accurate to 1e-5.
+    """
+    df = validation.count("df", df, minimum=1)
+    if df <= len(_T975):
+        return _T975[df - 1]
+    z = _Z975
+    return (z + (z**3 + z) / (4 * df) + (5 * z**5 + 16 * z**3 + 3 * z) / (96 * df**2)
+            + (3 * z**7 + 19 * z**5 + 17 * z**3 - 15 * z) / (384 * df**3))
+
+
+def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.ndarray:
+    """Mean squared error over time, after skipping ``burn_in_steps`` samples.
+
+    Parameters
+    ----------
+    estimate : array_like, shape (..., n)
+        Estimated positions (cm); leading axes are runs or a parameter sweep.
+    truth : array_like, shape (n,)
+        True positions (cm).
+    burn_in_steps : int
+        Samples skipped at the start, 0 <= burn_in_steps < n.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        MSE in cm².
+
+    Raises
+    ------
+    ValueError
+        If shapes differ on n, or NaN remains after the burn-in (e.g. a prediction
+        that does not exist yet: raise the burn-in to at least the delay).
+    """
+    estimate = np.asarray(estimate, dtype=float)
+    truth = validation.finite_array("truth", truth, min_ndim=1)
+    if estimate.ndim < 1 or estimate.shape[-1] != truth.shape[-1]:
+        raise ValueError(
+            f"estimate must have shape (..., n) with n = {truth.shape[-1]} like truth, "
+            f"got shape {estimate.shape}"
+        )
+    n_steps = truth.shape[-1]
+    burn_in_steps = validation.count("burn_in_steps", burn_in_steps, 0, n_steps - 1)
+    kept = estimate[..., burn_in_steps:]
+    if not np.all(np.isfinite(kept)):
+        first = int(np.argmax(~np.all(np.isfinite(kept), axis=tuple(range(kept.ndim - 1)))))
+        raise ValueError(
+            f"estimate must be finite after burn_in_steps = {burn_in_steps}, got NaN or inf "
+            f"at sample {burn_in_steps + first}; skip at least the samples with no estimate"
+        )
+    return np.mean((kept - truth[burn_in_steps:]) ** 2, axis=-1)
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A Monte Carlo mean with its two-sided 95 % confidence interval."""
+
+    mean: float
+    low: float
+    high: float
+    runs: int
+
+    @property
+    def half_width(self) -> float:
+        """Distance from the mean to either end of the interval."""
+        return (self.high - self.low) / 2
+
+    def __format__(self, spec: str) -> str:
+        spec = spec or ".3g"
+        return (f"{self.mean:{spec}} (95 % CI {self.low:{spec}} to {self.high:{spec}}, "
+                f"{self.runs} runs)")
+
+    def __str__(self) -> str:
+        return format(self, "")
+
+
+def mean_ci95(samples: np.ndarray) -> Interval:
+    """Mean of independent samples with a Student-t 95 % confidence interval.
+
+    Parameters
+    ----------
+    samples : array_like, shape (runs,)
+        One value per Monte Carlo run (e.g. per-run MSEs, or paired differences
+        of two MSEs computed on the same noise), at least 2 runs.
+
+    Returns
+    -------
+    Interval
+        ``mean ± t(0.975, runs − 1) · s / √runs``.
+    """
+    samples = validation.finite_array("samples", samples, min_ndim=1)
+    if samples.ndim != 1 or samples.size < 2:
+        raise ValueError(
+            f"samples must be a 1-D array of at least 2 runs, got shape {samples.shape}"
+        )
+    runs = samples.size
+    mean = float(np.mean(samples))
+    half = t_critical_95(runs - 1) * float(np.std(samples, ddof=1)) / np.sqrt(runs)
+    return Interval(mean, mean - half, mean + half, runs)
+
+
+def convergence_time(squared_error: np.ndarray, dt: float, factor: float = 2.0) -> np.ndarray:
+    """Time after which a squared-error curve stays within ``factor`` × its steady level.
+
+    Definition used throughout the pack: the steady level is the curve's mean over
+    the second half of the trial; the convergence time is the first sample time t
+    such that the curve is <= factor × steady level at t and at every later sample.
+    Apply it to the Monte Carlo mean of the squared position error, so that noise
+    averages out and what remains is the filter's approach to steady state.
+
+    Parameters
+    ----------
+    squared_error : array_like, shape (..., n)
+        Squared error (cm²) per sample, e.g. a Monte Carlo mean.
+    dt : float
+        Time step in s.
+    factor : float
+        Tolerance above the steady level, > 1.
+
+    Returns
+    -------
+    ndarray, shape (...)
+        Convergence time in s (0 if the curve never leaves the band).
+    """
+    curve = validation.finite_array("squared_error", squared_error, min_ndim=1)
+    if curve.shape[-1] < 2:
+        raise ValueError(f"squared_error needs at least 2 samples, got shape {curve.shape}")
+    if np.any(curve < 0):
+        raise ValueError("squared_error must be >= 0, got negative values")
+    dt = validation.positive("dt", dt, "s")
+    factor = validation.positive("factor", factor)
+    if factor <= 1:
+        raise ValueError(f"factor must be > 1, got {factor}")
+    n_steps = curve.shape[-1]
+    steady = np.mean(curve[..., n_steps // 2:], axis=-1, keepdims=True)
+    outside = curve > factor * steady
+    # Index just after the last sample outside the band (0 if none is outside).
+    last_outside = n_steps - np.argmax(outside[..., ::-1], axis=-1)
+    first_inside = np.where(np.any(outside, axis=-1), last_outside, 0)
+    return first_inside * dt
+
+
+def convergence_time_ci95(squared_errors: np.ndarray, dt: float, rng: np.random.Generator,
+                          factor: float = 2.0, resamples: int = 1000) -> Interval:
+    """Convergence time of the Monte Carlo mean curve, with a bootstrap 95 % interval.
+
+    Parameters
+    ----------
+    squared_errors : array_like, shape (runs, n)
+        Squared position error (cm²) of each run.
+    dt : float
+        Time step in s.
+    rng : numpy.random.Generator
+        Source of the bootstrap resampling.
+    factor : float
+        As in :func:`convergence_time`.
+    resamples : int
+        Bootstrap resamples of the runs.
+
+    Returns
+    -------
+    Interval
+        ``mean``: :func:`convergence_time` of the mean curve over all runs; ``low``,
+        ``high``: 2.5th and 97.5th percentiles over resampled sets of runs.
+    """
+    errors = validation.finite_array("squared_errors", squared_errors, min_ndim=2)
+    if errors.ndim != 2 or errors.shape[0] < 2:
+        raise ValueError(
+            f"squared_errors must have shape (runs, n) with runs >= 2, got {errors.shape}"
+        )
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(f"rng must be a numpy.random.Generator, got {rng!r}")
+    resamples = validation.count("resamples", resamples, minimum=10)
+    runs = errors.shape[0]
+    estimate = float(convergence_time(errors.mean(axis=0), dt, factor))
+    counts = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=resamples)
+    curves = counts @ errors / runs
+    times = convergence_time(curves, dt, factor)
+    low, high = np.percentile(times, [2.5, 97.5])
+    return Interval(estimate, float(low), float(high), runs)

@@ -1,0 +1,157 @@
+"""The butterfly model: matrices of the state and observation equations.
+
+State ``z = [p, v, a]``: position (cm), velocity (cm/s), acceleration (cm/s²).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from . import validation
+
+#: Sensors that can observe the butterfly, in the row order of ``C`` and ``R``.
+SENSORS = ("vision", "proprioception")
+
+
+def transition_matrix(dt: float) -> np.ndarray:
+    """Constant-acceleration transition matrix A (Tutorial eq. (4); Lesson 0.5 eq. (1)).
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        ``[[1, Δt, Δt²/2], [0, 1, Δt], [0, 0, 1]]``: position gains velocity·Δt plus
+        acceleration·Δt²/2, velocity gains acceleration·Δt, acceleration is kept.
+    """
+    dt = validation.positive("dt", dt, "s")
+    return np.array([[1.0, dt, dt * dt / 2.0], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+
+
+def jerk_input_matrix(dt: float) -> np.ndarray:
+    """Input matrix G of a jerk held constant over one step (Lesson 0.5 eqs. (4)–(5)).
+
+    A jerk ``j`` (cm/s³) held for Δt adds ``j Δt³/6`` to position, ``j Δt²/2`` to
+    velocity and ``j Δt`` to acceleration: the exact integrals, as in the lesson's
+    ``G = [Δt²/2, Δt]`` one derivative lower.
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 1)
+        ``[[Δt³/6], [Δt²/2], [Δt]]`` in s³, s², s.
+    """
+    dt = validation.positive("dt", dt, "s")
+    return np.array([[dt**3 / 6.0], [dt**2 / 2.0], [dt]])
+
+
+def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
+    """Process noise covariance ``Q = G σ_j² Gᵀ`` from the physics of the noise.
+
+    Lesson 0.5 eq. (9) propagates an input's variance through its input matrix:
+    ``P(k+1) = F P Fᵀ + G σ_u² Gᵀ``. Here the unknown input is the butterfly's jerk,
+    modelled as white noise held constant over each step with standard deviation
+    ``σ_j`` (cm/s³). Its contribution is ``Q = σ_j² G Gᵀ`` with ``G`` from
+    :func:`jerk_input_matrix`, so Q follows from one physical number instead of
+    nine hand-tuned entries. Q has rank 1: the three components of the noise are
+    perfectly correlated because one jerk drives them all.
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+    jerk_std : float
+        Standard deviation σ_j of the jerk in cm/s³, >= 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Q with units cm², cm²/s, cm²/s², ... (row i, column j: cm²/s^(i+j)).
+    """
+    jerk_std = validation.non_negative("jerk_std", jerk_std, "cm/s³")
+    g = jerk_input_matrix(dt)
+    return jerk_std**2 * (g @ g.T)
+
+
+def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
+    """Observation matrix C: each sensor reads the position (Tutorial eq. (3)).
+
+    Parameters
+    ----------
+    sensors : sequence of str
+        Sensors in row order, each one of :data:`SENSORS`, e.g. ``("vision",)`` or
+        ``("vision", "proprioception")``.
+
+    Returns
+    -------
+    ndarray, shape (m, 3)
+        One row ``[1, 0, 0]`` per sensor.
+    """
+    _check_sensors(sensors)
+    return np.tile([1.0, 0.0, 0.0], (len(sensors), 1))
+
+
+def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
+    """Sensor noise covariance ``R = diag(σ²)`` of independent sensors (Tutorial eq. (6)).
+
+    Parameters
+    ----------
+    sigmas : array_like, shape (..., m)
+        Sensor noise standard deviations in cm, each > 0. Leading axes are batch axes,
+        so a sweep over σ gives a stack of R matrices.
+
+    Returns
+    -------
+    ndarray, shape (..., m, m)
+    """
+    sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
+    if np.any(sigmas <= 0):
+        raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
+    variances = sigmas**2
+    eye = np.eye(sigmas.shape[-1])
+    return variances[..., :, None] * eye
+
+
+def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarray:
+    """Covariance ``variance · I`` such as the tutorial's ``P0 = diag(10⁵, 10⁵, 10⁵)``.
+
+    Parameters
+    ----------
+    variance : float or array_like, shape (...)
+        Variance of each component (cm², cm²/s², cm²/s⁴ for [p, v, a]), > 0. An
+        array gives a batch of covariances.
+    size : int
+        Dimension k of the state.
+
+    Returns
+    -------
+    ndarray, shape (..., size, size)
+    """
+    variance = validation.finite_array("variance", variance)
+    if np.any(variance <= 0):
+        raise ValueError(
+            f"variance must be > 0, got {np.ravel(variance)[:6].tolist()}"
+        )
+    size = validation.count("size", size, minimum=1)
+    return variance[..., None, None] * np.eye(size)
+
+
+def _check_sensors(sensors: Sequence[str]) -> None:
+    if isinstance(sensors, str) or len(sensors) == 0:
+        raise ValueError(
+            f"sensors must be a non-empty sequence of names from {SENSORS}, got {sensors!r}"
+        )
+    unknown = [s for s in sensors if s not in SENSORS]
+    if unknown or len(set(sensors)) != len(sensors):
+        raise ValueError(
+            f"sensors must be distinct names from {SENSORS}, got {tuple(sensors)!r}"
+        )

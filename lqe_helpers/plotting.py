@@ -1,0 +1,75 @@
+"""Figure conventions of the pack: one Okabe–Ito colour and one line style per role.
+
+Nothing here runs on import. A notebook opts in with :func:`use_pack_style`.
+"""
+
+from __future__ import annotations
+
+import matplotlib as mpl
+import numpy as np
+from matplotlib.axes import Axes
+
+#: Okabe–Ito colours by role, the same in every notebook.
+COLORS = {
+    "truth": "#000000",
+    "vision": "#999999",
+    "proprioception": "#E69F00",
+    "estimate": "#0072B2",
+    "prediction": "#D55E00",
+    "alternative": "#009E73",  # a second filtered estimate compared with the first
+    "reference": "#CC79A7",    # theory lines: steady states, σ² levels
+}
+
+#: Line and marker styles by role, so no role is told apart by colour alone.
+STYLES = {
+    "truth": {"color": COLORS["truth"], "linestyle": "-", "linewidth": 1.6},
+    "vision": {"color": COLORS["vision"], "linestyle": "none", "marker": ".",
+               "markersize": 3, "alpha": 0.7},
+    "proprioception": {"color": COLORS["proprioception"], "linestyle": "none", "marker": "x",
+                       "markersize": 3, "alpha": 0.6},
+    "estimate": {"color": COLORS["estimate"], "linestyle": "-", "linewidth": 1.6},
+    "prediction": {"color": COLORS["prediction"], "linestyle": "--", "linewidth": 1.6},
+    "alternative": {"color": COLORS["alternative"], "linestyle": "-.", "linewidth": 1.6},
+    "reference": {"color": COLORS["reference"], "linestyle": ":", "linewidth": 1.4},
+}
+
+#: rcParams applied by :func:`use_pack_style`.
+RC_PARAMS = {
+    "figure.figsize": (9.0, 4.0),
+    "figure.dpi": 100,
+    "savefig.dpi": 100,
+    "axes.grid": True,
+    "grid.alpha": 0.3,
+    "axes.spines.top": False,
+    "axes.spines.right": False,
+    "legend.frameon": False,
+    "font.size": 10,
+    "svg.hashsalt": "lqe-course-pack",
+}
+
+
+def use_pack_style() -> None:
+    """Apply the pack's matplotlib settings (call once at the top of a notebook)."""
+    mpl.rcParams.update(RC_PARAMS)
+
+
+def style(role: str, **overrides: object) -> dict:
+    """Keyword arguments for ``Axes.plot`` in one of the :data:`STYLES` roles."""
+    if role not in STYLES:
+        raise ValueError(f"role must be one of {tuple(STYLES)}, got {role!r}")
+    return {**STYLES[role], **overrides}
+
+
+def plot_band(ax: Axes, times: np.ndarray, centre: np.ndarray, std: np.ndarray,
+              role: str = "estimate", label: str | None = None) -> None:
+    """Shade ``centre ± 2·std`` in a light fill of the role's colour (≈ 95 % band)."""
+    if role not in COLORS:
+        raise ValueError(f"role must be one of {tuple(COLORS)}, got {role!r}")
+    ax.fill_between(times, centre - 2 * std, centre + 2 * std, color=COLORS[role],
+                    alpha=0.15, linewidth=0, label=label)
+
+
+def label_time_position(ax: Axes, position_unit: str = "cm") -> None:
+    """Standard axis labels: time (s) against position."""
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel(f"position ({position_unit})")

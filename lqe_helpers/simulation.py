@@ -1,0 +1,168 @@
+"""Simulated butterflies and sensors: truth, fixed noise draws, measurements, delays."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import validation
+
+
+def sinusoid_states(times: np.ndarray, amplitude: float, frequency: float) -> np.ndarray:
+    """Exact position, velocity and acceleration of ``p(t) = amplitude · sin(2π f t)``.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times in s.
+    amplitude : float
+        Amplitude in cm, > 0.
+    frequency : float
+        Frequency f in Hz, > 0.
+
+    Returns
+    -------
+    ndarray, shape (n, 3)
+        Columns p (cm), v (cm/s), a (cm/s²), from the analytic derivatives.
+    """
+    times = validation.finite_array("times", times, min_ndim=1)
+    amplitude = validation.positive("amplitude", amplitude, "cm")
+    frequency = validation.positive("frequency", frequency, "Hz")
+    omega = 2.0 * np.pi * frequency
+    phase = omega * times
+    return np.stack(
+        [amplitude * np.sin(phase),
+         amplitude * omega * np.cos(phase),
+         -amplitude * omega**2 * np.sin(phase)],
+        axis=-1,
+    )
+
+
+def unit_noise(rng: np.random.Generator, n_steps: int, n_sensors: int,
+               runs: int | None = None) -> np.ndarray:
+    """Standard normal noise, one independent stream per sensor, to be scaled by σ.
+
+    Drawing unit noise once and multiplying it by σ later means a σ slider changes
+    the noise level only, never the noise pattern. Sensor s always draws from the
+    s-th child of ``rng`` (:meth:`numpy.random.Generator.spawn`), so vision's noise is
+    the same whether or not proprioception is simulated beside it, and run r's noise
+    does not depend on how many runs are drawn.
+
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of randomness, e.g. ``np.random.default_rng(seed)``.
+    n_steps : int
+        Number of samples n, >= 1.
+    n_sensors : int
+        Number of sensors m, >= 1.
+    runs : int or None
+        Number of Monte Carlo runs; ``None`` for a single run without a run axis.
+
+    Returns
+    -------
+    ndarray, shape (n, m) or (runs, n, m)
+    """
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(
+            f"rng must be a numpy.random.Generator (np.random.default_rng(seed)), got {rng!r}"
+        )
+    n_steps = validation.count("n_steps", n_steps, minimum=1)
+    n_sensors = validation.count("n_sensors", n_sensors, minimum=1)
+    shape = (n_steps,) if runs is None else (validation.count("runs", runs, minimum=1), n_steps)
+    streams = rng.spawn(n_sensors)
+    return np.stack([stream.standard_normal(shape) for stream in streams], axis=-1)
+
+
+def measure(positions: np.ndarray, noise: np.ndarray, sigmas: np.ndarray) -> np.ndarray:
+    """Noisy position readings ``y = p + σ · noise`` (Tutorial eq. (3), one column per sensor).
+
+    Parameters
+    ----------
+    positions : array_like, shape (n,)
+        True positions in cm.
+    noise : array_like, shape (..., n, m)
+        Unit noise from :func:`unit_noise`.
+    sigmas : array_like, shape (..., m)
+        Sensor noise standard deviations in cm, > 0; leading axes broadcast against
+        noise's batch axes (e.g. a sweep of σ_p).
+
+    Returns
+    -------
+    ndarray, shape (..., n, m)
+        Measurements in cm.
+    """
+    positions = validation.finite_array("positions", positions, min_ndim=1)
+    noise = validation.finite_array("noise", noise, min_ndim=2)
+    sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
+    if np.any(sigmas <= 0):
+        raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
+    if positions.shape[-1] != noise.shape[-2] or sigmas.shape[-1] != noise.shape[-1]:
+        raise ValueError(
+            f"positions (n,), noise (..., n, m) and sigmas (..., m) must agree on n and m, "
+            f"got shapes {positions.shape}, {noise.shape} and {sigmas.shape}"
+        )
+    return positions[..., :, None] + sigmas[..., None, :] * noise
+
+
+def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
+    """What arrives ``steps`` samples late: ``out[j] = signal[j − steps]``, NaN before.
+
+    Parameters
+    ----------
+    signal : array_like
+        Any array with time along ``axis``: measurements (..., n, m), estimates
+        (..., n, k), or a position trace (n,) with ``axis=-1``.
+    steps : int
+        Delay δ in samples, 0 <= δ <= n − 1.
+    axis : int
+        The time axis.
+
+    Returns
+    -------
+    ndarray
+        Same shape as ``signal``; the first δ samples are NaN (nothing has arrived).
+    """
+    signal = np.asarray(signal, dtype=float)
+    if signal.ndim == 0:
+        raise ValueError(f"signal must have a time axis, got a scalar {signal!r}")
+    try:
+        n_steps = signal.shape[axis]
+    except IndexError:
+        raise ValueError(
+            f"axis must name an axis of signal with shape {signal.shape}, got {axis!r}"
+        ) from None
+    steps = validation.count("steps", steps, minimum=0, maximum=n_steps - 1)
+    moved = np.moveaxis(signal, axis, 0)
+    out = np.full(moved.shape, np.nan)
+    out[steps:] = moved[: n_steps - steps]
+    return np.moveaxis(out, 0, axis)
+
+
+def simulate_model_states(rng: np.random.Generator, A: np.ndarray, Q: np.ndarray,
+                          mean0: np.ndarray, P0: np.ndarray, n_steps: int,
+                          runs: int) -> np.ndarray:
+    """Truth drawn from the filter's own model (Tutorial eq. (1)), for consistency checks.
+
+    ``z_0 ~ N(A·mean0, P0)`` and ``z_j = A z_{j−1} + ω``, ``ω ~ N(0, Q)``: exactly the
+    statistics Tutorial eq. (5) assumes when it starts from ``ẑ = mean0, P = P0``.
+
+    Returns
+    -------
+    ndarray, shape (runs, n, k)
+    """
+    if not isinstance(rng, np.random.Generator):
+        raise ValueError(f"rng must be a numpy.random.Generator, got {rng!r}")
+    A = validation.square_matrix("A", A)
+    k = A.shape[-1]
+    Q = validation.covariance("Q", Q, size=k)
+    P0 = validation.covariance("P0", P0, size=k)
+    mean0 = validation.finite_array("mean0", mean0, min_ndim=1)
+    n_steps = validation.count("n_steps", n_steps, minimum=1)
+    runs = validation.count("runs", runs, minimum=1)
+    first = rng.multivariate_normal(A @ mean0, P0, size=runs, method="eigh")
+    kicks = rng.multivariate_normal(np.zeros(k), Q, size=(runs, n_steps), method="eigh")
+    states = np.empty((runs, n_steps, k))
+    states[:, 0] = first
+    for j in range(1, n_steps):
+        states[:, j] = states[:, j - 1] @ A.T + kicks[:, j]
+    return states

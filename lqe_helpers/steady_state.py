@@ -1,0 +1,109 @@
+"""The filter's steady state: the fixed point of the Riccati recursion in Tutorial eq. (5)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import validation
+
+
+@dataclass(frozen=True)
+class SteadyState:
+    """Limits of :func:`~lqe_helpers.filter.kalman_filter`'s outputs as ``j → ∞``.
+
+    Attributes
+    ----------
+    covariance : ndarray, shape (..., k, k)
+        ``P∞``: fixed point of ``P ← A (P − P Cᵀ (C P Cᵀ + R)⁻¹ C P) Aᵀ + Q``, the
+        covariance of the one-step prediction.
+    gain : ndarray, shape (..., k, m)
+        ``K∞ = P∞ Cᵀ (C P∞ Cᵀ + R)⁻¹``.
+    estimate_covariance : ndarray, shape (..., k, k)
+        ``(I − K∞ C) P∞``: the covariance of the estimate ``ẑ`` itself, whose [0, 0]
+        entry is the position error variance (cm²) an ideal model would reach.
+    """
+
+    covariance: np.ndarray
+    gain: np.ndarray
+    estimate_covariance: np.ndarray
+
+
+def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
+                 max_doublings: int = 200, rtol: float = 1e-13) -> SteadyState:
+    """Solve the filter's discrete algebraic Riccati equation by structured doubling.
+
+    The structure-preserving doubling algorithm (Chu, Fan & Lin 2005) doubles the
+    horizon each step (step i summarises 2^i steps of the recursion), so it reaches
+    the fixed point in tens of cheap steps instead of thousands.
+    Starting matrices: ``Aᵢ = Aᵀ``, ``Gᵢ = Cᵀ R⁻¹ C``, ``Hᵢ = Q``; each step::
+
+        W = (I + Gᵢ Hᵢ)⁻¹
+        Aᵢ₊₁ = Aᵢ W Aᵢ,  Gᵢ₊₁ = Gᵢ + Aᵢ W Gᵢ Aᵢᵀ,  Hᵢ₊₁ = Hᵢ + Aᵢᵀ Hᵢ W Aᵢ
+
+    and ``Hᵢ → P∞``.
+
+    Parameters
+    ----------
+    A : array_like, shape (k, k)
+    C : array_like, shape (m, k)
+    Q : array_like, shape (k, k)
+        Symmetric positive semidefinite; (A, Q) must excite every unstable mode.
+    R : array_like, shape (..., m, m)
+        Symmetric positive definite; a batch gives one steady state per R.
+    max_doublings : int
+        Limit on the doubling steps (2^200 recursion steps).
+    rtol : float
+        Relative change of P below which the iteration stops.
+
+    Returns
+    -------
+    SteadyState
+
+    Raises
+    ------
+    ValueError
+        If the inputs are invalid, or no finite fixed point is reached (C cannot see
+        an unstable mode of A, or Q does not drive it).
+    """
+    A = validation.square_matrix("A", A)
+    if A.ndim != 2:
+        raise ValueError(f"A must have shape (k, k), got shape {A.shape}")
+    k = A.shape[0]
+    C = validation.finite_array("C", C, min_ndim=2)
+    if C.ndim != 2 or C.shape[1] != k:
+        raise ValueError(f"C must have shape (m, {k}), got shape {C.shape}")
+    m = C.shape[0]
+    Q = validation.covariance("Q", Q, size=k)
+    if Q.ndim != 2:
+        raise ValueError(f"Q must have shape ({k}, {k}), got shape {Q.shape}")
+    R = validation.covariance("R", R, size=m, definite=True)
+    max_doublings = validation.count("max_doublings", max_doublings, minimum=1)
+    rtol = validation.positive("rtol", rtol)
+
+    batch = R.shape[:-2]
+    identity = np.eye(k)
+    A_i = np.broadcast_to(A.T, (*batch, k, k))
+    G_i = C.T @ np.linalg.solve(R, np.broadcast_to(C, (*batch, m, k)))
+    H_i = np.broadcast_to(Q, (*batch, k, k))
+    for _ in range(max_doublings):
+        W = np.linalg.inv(identity + G_i @ H_i)
+        A_next = A_i @ W @ A_i
+        G_next = G_i + A_i @ W @ G_i @ A_i.mT
+        H_next = H_i + A_i.mT @ H_i @ W @ A_i
+        H_next = 0.5 * (H_next + H_next.mT)
+        if not np.all(np.isfinite(H_next)):
+            break
+        change = np.max(np.abs(H_next - H_i)) / max(np.max(np.abs(H_next)), 1e-300)
+        A_i, G_i, H_i = A_next, 0.5 * (G_next + G_next.mT), H_next
+        if change <= rtol:
+            P = H_i
+            S = C @ P @ C.T + R
+            gain = np.linalg.solve(S, C @ P).mT
+            estimate = P - gain @ C @ P
+            return SteadyState(P, gain, 0.5 * (estimate + estimate.mT))
+    raise ValueError(
+        "the Riccati recursion has no finite fixed point for these A, C, Q and R: "
+        "C must observe, and Q must drive, every mode of A that does not decay"
+    )
