@@ -120,7 +120,7 @@ class Scenario:
     @property
     def n_steps(self) -> int:
         """Number of samples in a trial."""
-        return int(round(self.duration / self.dt))
+        return round(self.duration / self.dt)
 
     @property
     def times(self) -> np.ndarray:
@@ -130,7 +130,7 @@ class Scenario:
     @property
     def burn_in_steps(self) -> int:
         """:attr:`burn_in` in samples."""
-        return int(round(self.burn_in / self.dt))
+        return round(self.burn_in / self.dt)
 
     def delay_steps(self, delay: float) -> int:
         """A delay in s as a whole number of samples δ = d / Δt.
@@ -139,7 +139,7 @@ class Scenario:
         whole multiple of :attr:`dt`.
         """
         delay = validation.non_negative("delay", delay, "s")
-        steps = int(round(delay / self.dt))
+        steps = round(delay / self.dt)
         if abs(steps * self.dt - delay) > 1e-9 * max(1.0, delay):
             raise ValueError(
                 f"delay must be a whole number of time steps dt = {self.dt} s, got {delay} s"

@@ -88,11 +88,13 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
     G_i = C.T @ np.linalg.solve(R, np.broadcast_to(C, (*batch, m, k)))
     H_i = np.broadcast_to(Q, (*batch, k, k))
     for _ in range(max_doublings):
-        W = np.linalg.inv(identity + G_i @ H_i)
-        A_next = A_i @ W @ A_i
-        G_next = G_i + A_i @ W @ G_i @ A_i.mT
-        H_next = H_i + A_i.mT @ H_i @ W @ A_i
-        H_next = 0.5 * (H_next + H_next.mT)
+        # Without a fixed point H grows without bound: overflow is detected just below.
+        with np.errstate(over="ignore", invalid="ignore"):
+            W = np.linalg.inv(identity + G_i @ H_i)
+            A_next = A_i @ W @ A_i
+            G_next = G_i + A_i @ W @ G_i @ A_i.mT
+            H_next = H_i + A_i.mT @ H_i @ W @ A_i
+            H_next = 0.5 * (H_next + H_next.mT)
         if not np.all(np.isfinite(H_next)):
             break
         change = np.max(np.abs(H_next - H_i)) / max(np.max(np.abs(H_next)), 1e-300)

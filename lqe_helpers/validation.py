@@ -89,8 +89,9 @@ def covariance(name: str, value: object, size: int | None = None,
                definite: bool = False) -> np.ndarray:
     """Return a symmetric positive semidefinite (or definite) ``(..., n, n)`` array.
 
-    Symmetry and the eigenvalue sign are checked relative to the largest absolute
-    entry, with tolerance :data:`MATRIX_RTOL`.
+    Symmetry and a semidefinite matrix's eigenvalue sign are checked relative to the
+    largest absolute entry, with tolerance :data:`MATRIX_RTOL`; definiteness by the
+    existence of a Cholesky factor.
     """
     array = square_matrix(name, value, size)
     scale = np.max(np.abs(array), axis=(-2, -1), keepdims=True)
@@ -101,13 +102,19 @@ def covariance(name: str, value: object, size: int | None = None,
             f"{name} must be symmetric, got {_describe(array)} with relative "
             f"asymmetry {asymmetry:.3g}"
         )
+    if definite:
+        # Cholesky succeeds exactly for (numerically) positive definite matrices, however
+        # different the scales of their entries (R = diag(10⁶, 10⁻⁶) is fine).
+        try:
+            np.linalg.cholesky(array)
+        except np.linalg.LinAlgError:
+            raise ValueError(
+                f"{name} must be positive definite, got {_describe(array)} (no Cholesky "
+                f"factor exists)"
+            ) from None
+        return array
     eigenvalues = np.linalg.eigvalsh(array) / scale[..., 0]
     smallest = float(np.min(eigenvalues)) if eigenvalues.size else 0.0
-    if definite and smallest <= MATRIX_RTOL:
-        raise ValueError(
-            f"{name} must be positive definite, got {_describe(array)} whose smallest "
-            f"eigenvalue is {smallest:.3g} times its largest entry"
-        )
     if smallest < -MATRIX_RTOL:
         raise ValueError(
             f"{name} must be positive semidefinite, got {_describe(array)} with an "

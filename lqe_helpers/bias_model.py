@@ -1,0 +1,384 @@
+"""A measured acceleration with a bias, used as a known input (Lesson 0.5, bonus notebook).
+
+State ``z = [p, v, b]``: position (cm), velocity (cm/s) and the bias b (cm/s²) of an
+acceleration signal ``a_r = a + b + noise``. The signal is not measured against the
+state; it drives the prediction as an input, ``z_{j+1} = F z_j + G u_j`` (Lesson 0.5
+eq. (4)), and vision, which reads the position, corrects what the input gets wrong.
+
+In the nervous system the input could be an efference copy of the motor command or
+the otoliths' linear acceleration signal, both of which can carry a slowly varying
+offset; here the moving target is the hand of :data:`~lqe_helpers.scenario.DEFAULT`,
+whose path is the tutorial's sinusoid.
+
+Time convention (that of :func:`~lqe_helpers.filter.kalman_filter`): ``u_j`` is the
+reading over the step that ends at sample j, from ``t_j − Δt`` to ``t_j``, and the
+filter's ``z0`` is the estimate of the state at ``t = −Δt``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import metrics, model, simulation, validation
+from .filter import FilterResult, kalman_filter
+from .scenario import Scenario
+
+#: Column order of :func:`unit_noise`: vision's noise, then the acceleration signal's.
+NOISE_COLUMNS = ("vision", "acceleration")
+
+
+def transition_matrix(dt: float) -> np.ndarray:
+    """Transition matrix F of the biased-input model (Lesson 0.5 eq. (5)).
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        ``[[1, Δt, −Δt²/2], [0, 1, −Δt], [0, 0, 1]]``: the bias estimate is removed
+        from the input before it is integrated (Lesson 0.5 eq. (2)), and the bias
+        itself is taken as constant.
+    """
+    dt = validation.positive("dt", dt, "s")
+    return np.array([[1.0, dt, -dt * dt / 2.0], [0.0, 1.0, -dt], [0.0, 0.0, 1.0]])
+
+
+def input_matrix(dt: float) -> np.ndarray:
+    """Input matrix G of an acceleration held over one step (Lesson 0.5 eq. (5)).
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 1)
+        ``[[Δt²/2], [Δt], [0]]`` in s², s, s: what one step of a constant acceleration
+        adds to position and velocity; the bias does not respond to the input.
+    """
+    dt = validation.positive("dt", dt, "s")
+    return np.array([[dt * dt / 2.0], [dt], [0.0]])
+
+
+def process_noise_covariance(dt: float, sigma_a: float) -> np.ndarray:
+    """Covariance ``Q = G σ_a² Gᵀ`` that the input's noise adds each step (Lesson 0.5 eq. (9)).
+
+    The acceleration signal's noise, independent of the state, passes through the
+    same G as the signal, so its variance reaches position and velocity as
+    ``G σ_a² Gᵀ``; the model itself is exact and adds nothing.
+
+    Parameters
+    ----------
+    dt : float
+        Time step Δt in s, > 0.
+    sigma_a : float
+        Standard deviation σ_a of the signal's noise in cm/s², > 0.
+
+    Returns
+    -------
+    ndarray, shape (3, 3)
+        Q in cm², cm²/s, cm²/s² (zero in the bias row and column).
+    """
+    sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
+    g = input_matrix(dt)
+    return sigma_a**2 * (g @ g.T)
+
+
+def step_accelerations(scenario: Scenario) -> np.ndarray:
+    """True mean acceleration over the step that ends at each sample (cm/s²), shape (n,).
+
+    ``(v(t_j) − v(t_j − Δt)) / Δt`` from the scenario's exact sinusoid: what an
+    integrating acceleration sensor reports for that step. With it the noise-free,
+    unbiased model of :func:`transition_matrix` and :func:`input_matrix` reproduces
+    the true velocity exactly and the position to within 10⁻⁵ cm over a trial.
+    """
+    times = scenario.times
+    now = simulation.sinusoid_states(times, scenario.amplitude, scenario.frequency)
+    before = simulation.sinusoid_states(times - scenario.dt, scenario.amplitude,
+                                        scenario.frequency)
+    return (now[:, 1] - before[:, 1]) / scenario.dt
+
+
+def true_states(scenario: Scenario, bias: float) -> np.ndarray:
+    """True states ``[p, v, b]`` at the sample times, shape (n, 3), units cm, cm/s, cm/s².
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the path (the hand's sinusoid) and the sample times.
+    bias : float
+        The constant true bias b of the acceleration signal in cm/s² (any sign).
+    """
+    bias = _finite_number("bias", bias, "cm/s²")
+    states = scenario.truth[:, :3].copy()
+    states[:, 2] = bias
+    return states
+
+
+def initial_state(scenario: Scenario, bias: float) -> np.ndarray:
+    """True state ``[p, v, b]`` at ``t = −Δt``, the time the filter's ``z0`` refers to, shape (3,)."""
+    bias = _finite_number("bias", bias, "cm/s²")
+    p, v, _ = simulation.sinusoid_states(np.array([-scenario.dt]), scenario.amplitude,
+                                         scenario.frequency)[0]
+    return np.array([p, v, bias])
+
+
+def acceleration_readings(accelerations: np.ndarray, bias: float | np.ndarray,
+                          sigma_a: float | np.ndarray, noise: np.ndarray) -> np.ndarray:
+    """Biased, noisy acceleration signal ``a_r = a + b + σ_a · noise`` (Lesson 0.5 eq. (2)).
+
+    Parameters
+    ----------
+    accelerations : array_like, shape (n,)
+        True acceleration over each step (cm/s²), e.g. :func:`step_accelerations`.
+    bias : float or array_like, shape (...)
+        Constant bias b in cm/s² (any sign); leading axes broadcast against noise's.
+    sigma_a : float or array_like, shape (...)
+        Noise standard deviation σ_a in cm/s², >= 0; broadcasts like ``bias``.
+    noise : array_like, shape (..., n)
+        Standard normal noise, e.g. column 1 of :func:`unit_noise`.
+
+    Returns
+    -------
+    ndarray, shape (..., n)
+        Readings in cm/s²; the batch axes of bias, sigma_a and noise broadcast together.
+    """
+    accelerations = validation.finite_array("accelerations", accelerations, min_ndim=1)
+    if accelerations.ndim != 1:
+        raise ValueError(
+            f"accelerations must have shape (n,), got shape {accelerations.shape}"
+        )
+    bias = validation.finite_array("bias", bias)
+    sigma_a = validation.finite_array("sigma_a", sigma_a)
+    if np.any(sigma_a < 0):
+        raise ValueError(
+            f"sigma_a must be >= 0 cm/s², got {np.ravel(sigma_a)[:6].tolist()}"
+        )
+    noise = validation.finite_array("noise", noise, min_ndim=1)
+    if noise.shape[-1] != accelerations.shape[0]:
+        raise ValueError(
+            f"noise must have trailing length n = {accelerations.shape[0]} like "
+            f"accelerations, got shape {noise.shape}"
+        )
+    validation.broadcast_batches(bias=bias.shape, sigma_a=sigma_a.shape,
+                                 noise=noise.shape[:-1])
+    return accelerations + bias[..., None] + sigma_a[..., None] * noise
+
+
+def dead_reckoning(readings: np.ndarray, start: np.ndarray, dt: float,
+                   bias_estimate: float = 0.0) -> np.ndarray:
+    """Integrate the acceleration signal with no correction (Lesson 0.5 eqs. (2) and (4)).
+
+    From ``start`` at ``t = −Δt``, each reading ``u_j`` advances the state by
+    ``z_j = F z_{j−1} + G u_j`` with F and G of Lesson 0.5 eq. (5) and the bias
+    estimate held at ``bias_estimate``. This is how an observer with its eyes closed
+    would track the hand: any error in the bias grows into a position error of
+    ``b t² / 2``.
+
+    Parameters
+    ----------
+    readings : array_like, shape (..., n)
+        Acceleration signal u in cm/s², one reading per step.
+    start : array_like, shape (..., 2) or (..., 3)
+        Known position (cm) and velocity (cm/s) at ``t = −Δt``; a third entry, if
+        given, is ignored in favour of ``bias_estimate``.
+    dt : float
+        Time step Δt in s, > 0.
+    bias_estimate : float
+        The constant b̂ (cm/s²) subtracted from every reading; 0 for an observer that
+        does not know about the bias.
+
+    Returns
+    -------
+    ndarray, shape (..., n, 3)
+        ``[p, v, b̂]`` after each reading.
+    """
+    readings = validation.finite_array("readings", readings, min_ndim=1)
+    start = validation.finite_array("start", start, min_ndim=1)
+    if start.shape[-1] not in (2, 3):
+        raise ValueError(
+            f"start must have trailing length 2 [p, v] or 3 [p, v, b], got shape {start.shape}"
+        )
+    bias_estimate = _finite_number("bias_estimate", bias_estimate, "cm/s²")
+    F = transition_matrix(dt)
+    G = input_matrix(dt)[:, 0]
+    batch = validation.broadcast_batches(readings=readings.shape[:-1], start=start.shape[:-1])
+    n_steps = readings.shape[-1]
+    z = np.empty((*batch, 3))
+    z[..., :2] = start[..., :2]
+    z[..., 2] = bias_estimate
+    readings = np.broadcast_to(readings, (*batch, n_steps))
+    out = np.empty((*batch, n_steps, 3))
+    for j in range(n_steps):
+        z = z @ F.T + readings[..., j, None] * G
+        out[..., j, :] = z
+    return out
+
+
+def unit_noise(scenario: Scenario, runs: int | None = None) -> np.ndarray:
+    """Standard normal noise for vision and the acceleration signal, shape (..., n, 2).
+
+    Column 0 is exactly vision's noise from :meth:`Scenario.unit_noise`, so a
+    vision-only filter (``experiments.track``) sees the same camera noise and the
+    two can be compared run by run. Column 1 is a third independent stream from the
+    same seed, unused by the tutorial's sensors.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the seed and the number of samples.
+    runs : int, optional
+        Monte Carlo runs; None for the single run shown in figures (run 0).
+
+    Returns
+    -------
+    ndarray, shape (n, 2) or (runs, n, 2)
+        Columns in the order of :data:`NOISE_COLUMNS`.
+    """
+    streams = len(model.SENSORS) + 1
+    rng = np.random.default_rng(scenario.seed)
+    noise = simulation.unit_noise(rng, scenario.n_steps, streams, runs=runs)
+    return noise[..., [model.SENSORS.index("vision"), streams - 1]]
+
+
+@dataclass(frozen=True)
+class InputTracking:
+    """The hand tracked from vision plus a biased acceleration input.
+
+    Attributes
+    ----------
+    scenario : Scenario
+    bias, sigma_a, sigma_v : float
+        True bias (cm/s²), the signal's noise σ_a (cm/s²) and vision's σ_v (cm).
+    truth : ndarray, shape (n, 3)
+        True ``[p, v, b]``.
+    readings : ndarray, shape (..., n)
+        The acceleration signal u (cm/s²).
+    measurements : ndarray, shape (..., n, 1)
+        Vision's position readings (cm).
+    result : FilterResult
+        The filter's estimates ``[p̂, v̂, b̂]``, gains and covariances.
+    dead_reckoning : ndarray, shape (..., n, 3)
+        The signal integrated from the true start with no vision and b̂ = 0.
+    """
+
+    scenario: Scenario
+    bias: float
+    sigma_a: float
+    sigma_v: float
+    truth: np.ndarray
+    readings: np.ndarray
+    measurements: np.ndarray
+    result: FilterResult
+    dead_reckoning: np.ndarray
+
+    @property
+    def positions(self) -> np.ndarray:
+        """Filtered positions p̂ (cm), shape (..., n)."""
+        return self.result.estimates[..., 0]
+
+    @property
+    def bias_estimates(self) -> np.ndarray:
+        """Bias estimates b̂ (cm/s²), shape (..., n)."""
+        return self.result.estimates[..., 2]
+
+    @property
+    def bias_stds(self) -> np.ndarray:
+        """The filter's own standard deviation of b̂ (cm/s²), shape (..., n)."""
+        return np.sqrt(self.result.estimate_covariances[..., 2, 2])
+
+    @property
+    def position_stds(self) -> np.ndarray:
+        """The filter's own standard deviation of p̂ (cm), shape (..., n)."""
+        return np.sqrt(self.result.estimate_covariances[..., 0, 0])
+
+    def mse(self) -> np.ndarray:
+        """Per-run MSE (cm²) of the filtered position after the burn-in, shape (...)."""
+        return metrics.mse(self.positions, self.truth[:, 0], self.scenario.burn_in_steps)
+
+    def dead_reckoning_mse(self) -> np.ndarray:
+        """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
+        return metrics.mse(self.dead_reckoning[..., 0], self.truth[:, 0],
+                           self.scenario.burn_in_steps)
+
+
+def track_with_input(scenario: Scenario, bias: float = 20.0, sigma_a: float = 20.0,
+                     sigma_v: float | None = None, bias_prior_std: float = 50.0,
+                     runs: int | None = None, noise: np.ndarray | None = None
+                     ) -> InputTracking:
+    """Simulate vision and the biased signal, then filter with the signal as input.
+
+    The filter is :func:`~lqe_helpers.filter.kalman_filter` with ``A = F``, ``B = G``
+    (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)), ``C = [1, 0, 0]`` and
+    ``R = σ_v²``. It starts from ``z0 = [0, 0, 0]`` with prior standard deviations
+    of one amplitude A for position, the path's peak speed A·2πf for velocity and
+    ``bias_prior_std`` for the bias: the observer knows the range of the movement
+    and roughly how large a bias can be, nothing more.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        The hand's path, Δt, seed and burn-in.
+    bias : float
+        True constant bias b of the signal in cm/s² (any sign).
+    sigma_a : float
+        True noise σ_a of the signal in cm/s², > 0; the filter's Q uses the same value.
+    sigma_v : float, optional
+        Vision noise σ_v in cm, > 0. Default: the scenario's.
+    bias_prior_std : float
+        The filter's prior standard deviation of the bias in cm/s², > 0.
+    runs : int, optional
+        Monte Carlo runs; None for the single run shown in figures (run 0).
+    noise : array_like, shape (n, 2) or (runs, n, 2), optional
+        Unit noise ``[vision, acceleration]``; default :func:`unit_noise`. Explorers
+        pass a draw they keep, so a slider never changes the noise pattern.
+
+    Returns
+    -------
+    InputTracking
+        Leading axis: runs, if any.
+    """
+    bias = _finite_number("bias", bias, "cm/s²")
+    sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
+    sigma_v = validation.positive(
+        "sigma_v", scenario.sigma_v if sigma_v is None else sigma_v, "cm")
+    bias_prior_std = validation.positive("bias_prior_std", bias_prior_std, "cm/s²")
+    if noise is None:
+        noise = unit_noise(scenario, runs)
+    noise = validation.finite_array("noise", noise, min_ndim=2)
+    expected = (scenario.n_steps, 2) if runs is None else (runs, scenario.n_steps, 2)
+    if noise.shape != expected:
+        raise ValueError(f"noise must have shape {expected}, got shape {noise.shape}")
+
+    dt = scenario.dt
+    truth = true_states(scenario, bias)
+    readings = acceleration_readings(step_accelerations(scenario), bias, sigma_a,
+                                     noise[..., 1])
+    measurements = simulation.measure(truth[:, 0], noise[..., :1], np.array([sigma_v]))
+    speed = scenario.amplitude * 2.0 * np.pi * scenario.frequency
+    P0 = np.diag([scenario.amplitude**2, speed**2, bias_prior_std**2])
+    result = kalman_filter(
+        measurements, transition_matrix(dt), model.observation_matrix(("vision",)),
+        process_noise_covariance(dt, sigma_a), model.measurement_noise_covariance([sigma_v]),
+        np.zeros(3), P0, B=input_matrix(dt), u=readings[..., None],
+    )
+    drift = dead_reckoning(readings, initial_state(scenario, bias), dt)
+    return InputTracking(scenario, bias, sigma_a, sigma_v, truth, readings, measurements,
+                         result, drift)
+
+
+def _finite_number(name: str, value: float, unit: str) -> float:
+    """``value`` as a float if it is a finite number (any sign), else ``ValueError``."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number in {unit}, got {value!r}") from None
+    if not np.isfinite(number):
+        raise ValueError(f"{name} must be a finite number in {unit}, got {value!r}")
+    return number

@@ -1,0 +1,320 @@
+"""Build HTML handouts: every notebook executed fresh and rendered as one offline page.
+
+``python -m lqe_helpers.handouts [--source notebooks] [--out build/handouts]`` (or
+``make handouts``) writes::
+
+    build/handouts/index.html          links to every page, in notebook order
+    build/handouts/NN_name.html        one page per notebook: prose, code and figures
+    build/handouts/prose/index.html    the same without code cells
+    build/handouts/prose/NN_name.html  prose, printed results and figures only
+
+Each notebook is executed once, in a fresh kernel, by
+:func:`lqe_helpers.notebook_runner.execute_notebook`; a notebook that raises stops the
+build. Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
+
+- every figure embedded as a base64 ``data:`` URI (outputs and markdown images);
+- the widget-view mimetype left out of the display priority, so an explorer shows
+  its static figure at the default values with a note that the sliders live in
+  JupyterLab, never a widget placeholder;
+- no require.js, widget-manager or mermaid scripts. MathJax is the one remote script
+  and loads ``async``: offline, the equations stay readable as their LaTeX source
+  and nothing waits for the network;
+- nbconvert's ``TagRemovePreprocessor`` honouring the usual ``remove-cell``,
+  ``remove-input`` and ``remove-output`` tags, should an author want a cell hidden.
+"""
+
+from __future__ import annotations
+
+import argparse
+import copy
+import sys
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import nbformat
+from jinja2 import DictLoader
+from nbclient.exceptions import CellExecutionError
+from nbconvert.exporters import HTMLExporter
+from traitlets.config import Config
+
+from lqe_helpers.notebook_runner import execute_notebook
+from lqe_helpers.student_edition import check_out_dir, source_notebooks
+
+#: Folder (inside the output folder) of the variant without code cells.
+PROSE_DIR = "prose"
+#: Title of the index pages.
+PACK_TITLE = "The Linear Quadratic Estimator: tracking a butterfly"
+#: Where MathJax comes from; an empty string leaves it out (equations stay as LaTeX).
+DEFAULT_MATHJAX_URL = (
+    "https://cdnjs.cloudflare.com/ajax/libs/mathjax/2.7.7/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
+)
+#: What an HTML page may show from a display bundle, best first. The widget view is
+#: not in the list: with no widget manager it could only render as a placeholder.
+DISPLAY_PRIORITY = [
+    "text/html",
+    "text/markdown",
+    "image/svg+xml",
+    "text/latex",
+    "image/png",
+    "image/jpeg",
+    "text/plain",
+]
+
+_TEMPLATE_NAME = "lqe_handout.html.j2"
+_TEMPLATE = r"""
+{%- extends 'index.html.j2' -%}
+
+{%- macro lqe_nav(nav) -%}
+{%- if nav -%}
+<nav class="lqe-nav" aria-label="Handout pages">
+  <span>{%- if nav.previous -%}
+    <a rel="prev" href="{{ nav.previous.href }}">&larr; {{ nav.previous.title | e }}</a>
+  {%- endif -%}</span>
+  <a href="{{ nav.index }}">All handouts</a>
+  <span>{%- if nav.next -%}
+    <a rel="next" href="{{ nav.next.href }}">{{ nav.next.title | e }} &rarr;</a>
+  {%- endif -%}</span>
+</nav>
+{%- endif -%}
+{%- endmacro -%}
+
+{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
+{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+
+{%- block html_head_js_mathjax -%}
+{%- if resources.mathjax_url -%}
+<script type="text/x-mathjax-config">
+MathJax.Hub.Config({
+  TeX: {equationNumbers: {autoNumber: "AMS", useLabelIds: true}},
+  tex2jax: {
+    inlineMath: [["$", "$"], ["\\(", "\\)"]],
+    displayMath: [["$$", "$$"], ["\\[", "\\]"]],
+    processEscapes: true,
+    processEnvironments: true
+  },
+  displayAlign: "center",
+  messageStyle: "none",
+  CommonHTML: {linebreaks: {automatic: true}}
+});
+</script>
+<script async src="{{ resources.mathjax_url }}"></script>
+{%- endif -%}
+{%- endblock html_head_js_mathjax -%}
+
+{%- block extra_css -%}
+<style type="text/css">
+nav.lqe-nav {
+  display: flex; justify-content: space-between; gap: 1em;
+  max-width: 1100px; margin: 0.5em auto; padding: 0.4em 1em;
+  font-family: var(--jp-ui-font-family); font-size: 0.95em;
+  border-bottom: 1px solid var(--jp-border-color2);
+}
+nav.lqe-nav + main, main + nav.lqe-nav { border-top: 1px solid var(--jp-border-color2); }
+figure.lqe-explorer { margin: 0; }
+figure.lqe-explorer img { max-width: 100%; height: auto; }
+figure.lqe-explorer figcaption { color: var(--jp-content-font-color2); margin-top: 0.3em; }
+</style>
+{%- endblock extra_css -%}
+
+{%- block body_header -%}
+{{ super() }}
+{{ lqe_nav(resources.lqe_nav) }}
+{%- endblock body_header -%}
+
+{%- block body_footer -%}
+{{ lqe_nav(resources.lqe_nav) }}
+{{ super() }}
+{%- endblock body_footer -%}
+"""
+
+
+class HandoutBuildError(RuntimeError):
+    """A notebook could not be turned into a handout (it raised, or shows an error)."""
+
+
+@dataclass(frozen=True)
+class Page:
+    """One handout page: the notebook's file stem and its title."""
+
+    stem: str
+    title: str
+
+    @property
+    def href(self) -> str:
+        """The page's file name, relative to its index."""
+        return f"{self.stem}.html"
+
+
+def notebook_title(notebook: nbformat.NotebookNode, fallback: str) -> str:
+    """The text of the first markdown heading of ``notebook``, else ``fallback``."""
+    for cell in notebook.cells:
+        if cell.cell_type != "markdown":
+            continue
+        for line in cell.source.splitlines():
+            if line.startswith("#"):
+                title = line.lstrip("#").strip()
+                if title:
+                    return title
+    return fallback
+
+
+def error_outputs(notebook: nbformat.NotebookNode) -> list[str]:
+    """Where ``notebook`` shows an error: ``"cell N: Name: message"`` per error output."""
+    found = []
+    for index, cell in enumerate(notebook.cells):
+        for output in cell.get("outputs", []):
+            if output.get("output_type") == "error":
+                found.append(f"cell {index}: {output.get('ename')}: {output.get('evalue')}")
+    return found
+
+
+def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_URL) -> HTMLExporter:
+    """The HTML exporter for handout pages.
+
+    Parameters
+    ----------
+    code : bool
+        Show the code cells' source (``False`` for the prose variant: markdown,
+        printed results and figures only, without prompts).
+    mathjax_url : str
+        Where MathJax is loaded from (``async``); ``""`` leaves MathJax out.
+    """
+    config = Config()
+    config.NbConvertBase.display_data_priority = list(DISPLAY_PRIORITY)
+    config.HTMLExporter.embed_images = True
+    config.HTMLExporter.mathjax_url = mathjax_url
+    config.TagRemovePreprocessor.enabled = True
+    config.TagRemovePreprocessor.remove_cell_tags = {"remove-cell"}
+    config.TagRemovePreprocessor.remove_input_tags = {"remove-input"}
+    config.TagRemovePreprocessor.remove_all_outputs_tags = {"remove-output"}
+    if not code:
+        config.TemplateExporter.exclude_input = True
+        config.TemplateExporter.exclude_input_prompt = True
+        config.TemplateExporter.exclude_output_prompt = True
+    exporter = HTMLExporter(config=config, template_name="lab",
+                            extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
+    exporter.template_file = _TEMPLATE_NAME
+    return exporter
+
+
+def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNode:
+    """A one-cell notebook whose markdown lists ``pages`` in order (the index page)."""
+    if code:
+        intro = ("Each page is a notebook of the pack, executed afresh: the text, the code and "
+                 "every figure. The interactive explorers appear as a figure at their default "
+                 "values; open the notebooks in JupyterLab to move their sliders. The same pages "
+                 f"without code are in [{PROSE_DIR}/]({PROSE_DIR}/index.html).")
+    else:
+        intro = ("Each page is a notebook of the pack, executed afresh, showing its text, "
+                 "printed results and figures without the code. The interactive explorers "
+                 "appear as a figure at their default values; open the notebooks in JupyterLab "
+                 "to move their sliders. The pages with code are [here](../index.html).")
+    items = []
+    for number, page in enumerate(pages, start=1):
+        title = page.title.replace("[", r"\[").replace("]", r"\]")
+        items.append(f"{number}. [{title}]({page.href})")
+    heading = f"# {PACK_TITLE}" + ("" if code else " (without code)")
+    source = "\n".join([heading, "", intro, "", *items])
+    notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell(source)])
+    notebook.metadata["title"] = PACK_TITLE
+    return notebook
+
+
+def _execute(path: Path) -> nbformat.NotebookNode:
+    """Execute ``path`` fresh; raise :class:`HandoutBuildError` if it shows an error."""
+    try:
+        notebook = execute_notebook(path)
+    except CellExecutionError as error:
+        raise HandoutBuildError(f"{path} raised while executing: {error}") from error
+    errors = error_outputs(notebook)
+    if errors:
+        raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}")
+    notebook.metadata.pop("widgets", None)
+    return notebook
+
+
+def build_handouts(source_dir: Path, out_dir: Path, *,
+                   mathjax_url: str = DEFAULT_MATHJAX_URL) -> list[Path]:
+    """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
+
+    Parameters
+    ----------
+    source_dir : Path
+        Folder of the source notebooks (``*.ipynb``, in name order; read only).
+    out_dir : Path
+        Output folder (created if needed). Receives ``NN_name.html`` per notebook and
+        ``index.html``; ``out_dir/prose/`` receives the same without code cells.
+    mathjax_url : str
+        Where the pages load MathJax from (asynchronously); ``""`` leaves it out.
+
+    Returns
+    -------
+    list of Path
+        The pages with code in notebook order, then ``index.html``, then the
+        prose pages and ``prose/index.html``.
+
+    Raises
+    ------
+    ValueError
+        If ``source_dir`` holds no notebook or ``out_dir`` is ``source_dir``.
+    HandoutBuildError
+        If a notebook raises or shows an error output.
+    """
+    source_dir, out_dir = Path(source_dir), Path(out_dir)
+    paths = source_notebooks(source_dir)
+    check_out_dir(source_dir, out_dir)
+    executed = [(path, _execute(path)) for path in paths]
+    pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
+
+    written = []
+    for code, folder in ((True, out_dir), (False, out_dir / PROSE_DIR)):
+        folder.mkdir(parents=True, exist_ok=True)
+        exporter = handout_exporter(code=code, mathjax_url=mathjax_url)
+        for number, ((path, notebook), page) in enumerate(zip(executed, pages, strict=True)):
+            nav = {
+                "index": "index.html",
+                "previous": pages[number - 1] if number > 0 else None,
+                "next": pages[number + 1] if number + 1 < len(pages) else None,
+            }
+            notebook = copy.deepcopy(notebook)
+            notebook.metadata["title"] = page.title
+            resources = {"metadata": {"name": page.stem, "path": str(path.parent.resolve())},
+                         "lqe_nav": nav}
+            html, _ = exporter.from_notebook_node(notebook, resources)
+            target = folder / page.href
+            target.write_text(html, encoding="utf-8")
+            written.append(target)
+        html, _ = exporter.from_notebook_node(
+            _index_notebook(pages, code=code), {"metadata": {"name": "index"}})
+        target = folder / "index.html"
+        target.write_text(html, encoding="utf-8")
+        written.append(target)
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: build the handouts and list the files written."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--source", type=Path, default=Path("notebooks"),
+                        help="folder of the source notebooks (default: notebooks)")
+    parser.add_argument("--out", type=Path, default=Path("build/handouts"),
+                        help="output folder (default: build/handouts)")
+    parser.add_argument("--mathjax-url", default=DEFAULT_MATHJAX_URL,
+                        help="where pages load MathJax from; '' for none (LaTeX shown as text)")
+    args = parser.parse_args(argv)
+    try:
+        written = build_handouts(args.source, args.out, mathjax_url=args.mathjax_url)
+    except ValueError as error:
+        parser.error(str(error))
+    except HandoutBuildError as error:
+        print(f"error: {error}", file=sys.stderr)
+        return 1
+    for path in written:
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

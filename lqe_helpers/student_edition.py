@@ -1,0 +1,282 @@
+"""Build the student edition: the notebooks with their worked solutions taken out.
+
+``python -m lqe_helpers.student_edition [--source notebooks] [--out build/student]``
+(or ``make student``) writes one ``.ipynb`` per source notebook into the output folder.
+
+The source notebooks mark what is a solution with cell tags (one convention for the
+whole pack):
+
+``solution``
+    A code cell holding a worked answer. Its first lines are comments, the first of
+    which starts with ``# Task:``; that leading comment block is the instruction. In
+    the student edition the cell keeps only those comment lines, followed by
+    ``raise NotImplementedError(...)``, and its tag becomes ``task``.
+``answer``
+    A markdown cell holding a written answer. In the student edition it becomes an
+    answer prompt ("**Your answer:** ...") tagged ``answer-prompt``.
+``explorer``
+    A code cell that displays an interactive explorer. It is self-contained and kept
+    as it is, so the sliders work in the student edition too.
+
+Every output and execution count is cleared, and notebook metadata other than the
+kernel and language (widget state included) is dropped. The source notebooks are
+only read, never written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import nbformat
+from nbconvert.exporters import NotebookExporter
+from nbconvert.preprocessors import (
+    ClearMetadataPreprocessor,
+    ClearOutputPreprocessor,
+    Preprocessor,
+)
+from traitlets import Unicode
+
+#: Tag of a code cell holding a worked solution (source notebooks).
+SOLUTION_TAG = "solution"
+#: Tag of a markdown cell holding a written answer (source notebooks).
+ANSWER_TAG = "answer"
+#: Tag of a code cell showing an interactive explorer (kept in the student edition).
+EXPLORER_TAG = "explorer"
+#: Tag of the stub that replaces a solution cell (student edition).
+TASK_TAG = "task"
+#: Tag of the prompt that replaces an answer cell (student edition).
+ANSWER_PROMPT_TAG = "answer-prompt"
+#: Tag of the note on how to use the student edition, inserted after the title cell.
+NOTE_TAG = "student-note"
+
+#: How the instruction at the top of a solution cell starts.
+TASK_PREFIX = "# Task:"
+#: What a stub raises.
+STUB_MESSAGE = "Replace this line with your code for the task described above."
+#: What an answer cell becomes.
+ANSWER_PROMPT = (
+    "**Your answer:** *Replace this line with your answer, backed by the numbers "
+    "and figures your code produced.*"
+)
+#: Markdown inserted after the first cell of every student notebook.
+STUDENT_NOTE = (
+    "> **Student edition.** Cells starting with `# Task:` are yours to write: replace "
+    "their `raise NotImplementedError(...)` line with code that does what the comment "
+    "asks, and run the notebook from the top. Write your answers where it says "
+    "**Your answer**. The interactive explorers work at any time: run the first code "
+    "cell, then the explorer's cell."
+)
+
+
+def task_instruction(source: str) -> list[str]:
+    """The instruction lines at the top of a solution cell.
+
+    Parameters
+    ----------
+    source : str
+        The cell's source code.
+
+    Returns
+    -------
+    list of str
+        The leading block of comment lines (up to the first line that is not a
+        comment), the first of which starts with ``# Task:``.
+
+    Raises
+    ------
+    ValueError
+        If the cell does not start with a ``# Task:`` line.
+    """
+    lines = source.splitlines()
+    if not lines or not lines[0].startswith(TASK_PREFIX):
+        first = lines[0] if lines else ""
+        raise ValueError(
+            f"a solution cell must start with a '{TASK_PREFIX} ...' comment line, "
+            f"got {first!r}"
+        )
+    block = []
+    for line in lines:
+        if not line.lstrip().startswith("#"):
+            break
+        block.append(line.rstrip())
+    return block
+
+
+def stub_source(source: str) -> str:
+    """The student-edition stub for a solution cell: its task comment, then a raise."""
+    return "\n".join([*task_instruction(source), f"raise NotImplementedError({STUB_MESSAGE!r})"])
+
+
+def _tags(cell: nbformat.NotebookNode) -> list[str]:
+    return list(cell.get("metadata", {}).get("tags", []))
+
+
+class StudentEditionPreprocessor(Preprocessor):
+    """Turn marked solution cells into stubs and marked answers into prompts.
+
+    Keyed on cell tags: a code cell tagged ``solution`` keeps its leading
+    ``# Task:`` comment block followed by ``raise NotImplementedError(...)``; a
+    markdown cell tagged ``answer`` becomes an answer prompt. Everything else,
+    explorer cells included, passes through unchanged. A note on how to use the
+    student edition is inserted after the first cell.
+
+    Raises
+    ------
+    ValueError
+        If a tag sits on the wrong kind of cell, an explorer is also marked as a
+        solution or answer, or a solution cell lacks its ``# Task:`` line. The
+        message names the notebook and the cell.
+    """
+
+    solution_tag = Unicode(SOLUTION_TAG, help="Tag of worked-solution code cells.").tag(
+        config=True)
+    answer_tag = Unicode(ANSWER_TAG, help="Tag of written-answer markdown cells.").tag(
+        config=True)
+    explorer_tag = Unicode(EXPLORER_TAG, help="Tag of explorer code cells.").tag(config=True)
+    task_tag = Unicode(TASK_TAG, help="Tag given to the stubs.").tag(config=True)
+    answer_prompt_tag = Unicode(ANSWER_PROMPT_TAG, help="Tag given to the prompts.").tag(
+        config=True)
+
+    def preprocess(self, nb: nbformat.NotebookNode,
+                   resources: dict[str, Any]) -> tuple[nbformat.NotebookNode, dict[str, Any]]:
+        """Transform every cell, then insert the note on how to use the edition."""
+        nb, resources = super().preprocess(nb, resources)
+        note = nbformat.v4.new_markdown_cell(STUDENT_NOTE, metadata={"tags": [NOTE_TAG]})
+        nb.cells.insert(min(1, len(nb.cells)), note)
+        return nb, resources
+
+    def preprocess_cell(self, cell: nbformat.NotebookNode, resources: dict[str, Any],
+                        index: int) -> tuple[nbformat.NotebookNode, dict[str, Any]]:
+        """Stub a solution cell, turn an answer cell into a prompt, keep the rest."""
+        tags = _tags(cell)
+        is_solution = self.solution_tag in tags
+        is_answer = self.answer_tag in tags
+        if not (is_solution or is_answer):
+            return cell, resources
+        where = f"{resources.get('metadata', {}).get('name', 'notebook')}, cell {index}"
+        if is_solution and is_answer:
+            raise ValueError(f"{where}: a cell cannot be tagged both "
+                             f"{self.solution_tag!r} and {self.answer_tag!r}")
+        if self.explorer_tag in tags:
+            raise ValueError(f"{where}: an {self.explorer_tag!r} cell must not also be "
+                             f"tagged {self.solution_tag if is_solution else self.answer_tag!r}")
+        if is_solution:
+            if cell.cell_type != "code":
+                raise ValueError(f"{where}: tag {self.solution_tag!r} is for code cells, "
+                                 f"got a {cell.cell_type} cell")
+            try:
+                cell.source = stub_source(cell.source)
+            except ValueError as error:
+                raise ValueError(f"{where}: {error}") from None
+            new_tag = self.task_tag
+        else:
+            if cell.cell_type != "markdown":
+                raise ValueError(f"{where}: tag {self.answer_tag!r} is for markdown cells, "
+                                 f"got a {cell.cell_type} cell")
+            cell.source = ANSWER_PROMPT
+            cell.pop("attachments", None)
+            new_tag = self.answer_prompt_tag
+        old = {self.solution_tag, self.answer_tag}
+        cell.metadata["tags"] = [new_tag, *(tag for tag in tags if tag not in old)]
+        return cell, resources
+
+
+def student_exporter() -> NotebookExporter:
+    """A notebook-to-notebook exporter that produces the student edition."""
+    exporter = NotebookExporter()
+    exporter.register_preprocessor(ClearOutputPreprocessor(), enabled=True)
+    exporter.register_preprocessor(StudentEditionPreprocessor(), enabled=True)
+    exporter.register_preprocessor(
+        ClearMetadataPreprocessor(
+            preserve_nb_metadata_mask={"kernelspec", "language_info"},
+            preserve_cell_metadata_mask={"tags"},
+        ),
+        enabled=True,
+    )
+    return exporter
+
+
+def source_notebooks(source_dir: Path) -> list[Path]:
+    """The ``*.ipynb`` files directly in ``source_dir``, in name order.
+
+    Raises
+    ------
+    ValueError
+        If ``source_dir`` is not a folder or holds no notebook.
+    """
+    source_dir = Path(source_dir)
+    if not source_dir.is_dir():
+        raise ValueError(f"source_dir must be an existing folder, got {source_dir}")
+    notebooks = sorted(source_dir.glob("*.ipynb"))
+    if not notebooks:
+        raise ValueError(f"source_dir must hold at least one .ipynb file, got none in "
+                         f"{source_dir}")
+    return notebooks
+
+
+def check_out_dir(source_dir: Path, out_dir: Path) -> None:
+    """Refuse an output folder that would overwrite the source notebooks."""
+    if Path(out_dir).resolve() == Path(source_dir).resolve():
+        raise ValueError(f"out_dir must differ from source_dir, got {out_dir} for both")
+
+
+def build_student_edition(source_dir: Path, out_dir: Path) -> list[Path]:
+    """Write the student edition of every notebook in ``source_dir`` to ``out_dir``.
+
+    Parameters
+    ----------
+    source_dir : Path
+        Folder of the source notebooks (read only).
+    out_dir : Path
+        Folder for the student notebooks (created if needed); files of the same
+        name are overwritten.
+
+    Returns
+    -------
+    list of Path
+        The written notebooks, in name order.
+
+    Raises
+    ------
+    ValueError
+        If the folders are unusable or a notebook breaks the tag convention.
+    """
+    source_dir, out_dir = Path(source_dir), Path(out_dir)
+    notebooks = source_notebooks(source_dir)
+    check_out_dir(source_dir, out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    exporter = student_exporter()
+    written = []
+    for path in notebooks:
+        notebook = nbformat.read(path, as_version=4)
+        resources = {"metadata": {"name": path.stem, "path": str(path.parent)}}
+        text, _ = exporter.from_notebook_node(notebook, resources)
+        target = out_dir / path.name
+        target.write_text(text, encoding="utf-8")
+        written.append(target)
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: build the student edition and list the files written."""
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--source", type=Path, default=Path("notebooks"),
+                        help="folder of the source notebooks (default: notebooks)")
+    parser.add_argument("--out", type=Path, default=Path("build/student"),
+                        help="folder for the student notebooks (default: build/student)")
+    args = parser.parse_args(argv)
+    try:
+        written = build_student_edition(args.source, args.out)
+    except ValueError as error:
+        parser.error(str(error))
+    for path in written:
+        print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,97 @@
+"""MSE, Monte Carlo intervals and convergence time."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import stats
+
+from lqe_helpers import metrics
+
+
+def test_mse_by_hand_and_burn_in() -> None:
+    truth = np.zeros(4)
+    estimate = np.array([[10.0, 1.0, 2.0, 3.0], [0.0, 0.0, 0.0, 2.0]])
+    np.testing.assert_allclose(metrics.mse(estimate, truth), [114 / 4, 1.0])
+    np.testing.assert_allclose(metrics.mse(estimate, truth, burn_in_steps=1), [14 / 3, 4 / 3])
+
+
+def test_mse_refuses_nan_after_burn_in() -> None:
+    estimate = np.array([np.nan, np.nan, 1.0, 1.0])
+    with pytest.raises(ValueError, match="estimate must be finite after burn_in_steps = 1"):
+        metrics.mse(estimate, np.zeros(4), burn_in_steps=1)
+    assert metrics.mse(estimate, np.zeros(4), burn_in_steps=2) == 1.0
+
+
+@pytest.mark.parametrize("df", [1, 2, 5, 10, 29, 30, 31, 50, 299, 10_000])
+def test_t_critical_matches_scipy(df: int) -> None:
+    assert metrics.t_critical_95(df) == pytest.approx(stats.t.ppf(0.975, df), abs=2e-4)
+
+
+def test_mean_ci95_matches_scipy_t_interval() -> None:
+    samples = np.random.default_rng(0).normal(3.0, 2.0, size=40)
+    interval = metrics.mean_ci95(samples)
+    low, high = stats.t.interval(0.95, 39, loc=samples.mean(), scale=stats.sem(samples))
+    assert interval.mean == pytest.approx(samples.mean())
+    assert interval.low == pytest.approx(low, rel=1e-4)
+    assert interval.high == pytest.approx(high, rel=1e-4)
+    assert interval.runs == 40
+    assert "95 % CI" in f"{interval:.2f}"
+
+
+def test_mean_ci95_covers_the_true_mean_95_percent_of_the_time() -> None:
+    rng = np.random.default_rng(1)
+    draws = rng.exponential(1.0, size=(4000, 60))  # skewed, like per-run MSEs
+    covered = [iv.low <= 1.0 <= iv.high for iv in map(metrics.mean_ci95, draws)]
+    assert 0.93 <= np.mean(covered) <= 0.96
+
+
+def test_convergence_time_definition() -> None:
+    curve = np.concatenate([np.full(10, 50.0), [3.0, 1.5, 2.5], np.ones(87)])
+    # Steady level = 1 (mean of second half); band = 2; last sample above 2 is index 12.
+    assert metrics.convergence_time(curve, dt=0.1) == pytest.approx(1.3)
+    assert metrics.convergence_time(np.ones(10), dt=0.1) == 0.0
+    batch = np.stack([curve, np.ones(100)])
+    np.testing.assert_allclose(metrics.convergence_time(batch, dt=0.1), [1.3, 0.0])
+
+
+def test_convergence_time_interval_brackets_the_estimate() -> None:
+    rng = np.random.default_rng(2)
+    n = 400
+    decay = 40 * np.exp(-np.arange(n) / 30.0) + 1.0
+    errors = decay * rng.chisquare(1, size=(300, n))
+    interval = metrics.convergence_time_ci95(errors, 0.01, np.random.default_rng(3))
+    assert interval.low <= interval.mean <= interval.high
+    # True curve: 40 e^{-t/30} + 1 crosses 2 at index 30 ln 40 ≈ 110.7 → 1.11 s.
+    assert interval.low < 1.11 < interval.high + 0.1
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: metrics.mean_ci95([1.0]), "samples must be a 1-D array of at least 2 runs"),
+        (lambda: metrics.mean_ci95([1.0, np.nan]), "samples must contain only finite"),
+        (
+            lambda: metrics.mse(np.zeros(3), np.zeros(4)),
+            r"estimate must have shape \(..., n\) with n = 4",
+        ),
+        (
+            lambda: metrics.mse(np.zeros(4), np.zeros(4), burn_in_steps=4),
+            r"burn_in_steps must be a whole number in \[0, 3\], got 4",
+        ),
+        (
+            lambda: metrics.convergence_time(np.ones(5), 0.1, factor=1.0),
+            "factor must be > 1, got 1.0",
+        ),
+        (lambda: metrics.convergence_time(-np.ones(5), 0.1), "squared_error must be >= 0"),
+        (lambda: metrics.convergence_time(np.ones(5), 0.0), "dt must be a finite number > 0 s"),
+        (
+            lambda: metrics.convergence_time_ci95(np.ones((1, 5)), 0.1, np.random.default_rng(0)),
+            "runs >= 2",
+        ),
+        (lambda: metrics.t_critical_95(0), "df must be a whole number >= 1, got 0"),
+    ],
+)
+def test_bad_input(call, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()

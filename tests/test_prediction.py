@@ -1,0 +1,74 @@
+"""Prediction past a delay (Tutorial eq. (7)) and open-loop covariance growth."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lqe_helpers import model
+from lqe_helpers.prediction import predict_ahead, propagate_covariance
+
+
+def test_predict_ahead_applies_a_power_to_older_estimates() -> None:
+    A = model.transition_matrix(0.01)
+    rng = np.random.default_rng(0)
+    estimates = rng.normal(size=(2, 30, 3))
+    out = predict_ahead(estimates, A, 10)
+    assert out.shape == estimates.shape
+    assert np.all(np.isnan(out[:, :10]))
+    A10 = A
+    for _ in range(9):
+        A10 = A10 @ A
+    np.testing.assert_allclose(out[:, 10:], estimates[:, :20] @ A10.T, rtol=1e-12)
+    np.testing.assert_array_equal(predict_ahead(estimates, A, 0), estimates)
+
+
+def test_prediction_of_a_constant_acceleration_path_is_exact() -> None:
+    dt = 0.01
+    t = np.arange(100) * dt
+    states = np.stack([3 + 2 * t + 5 * t**2, 2 + 10 * t, np.full_like(t, 10.0)], axis=-1)
+    out = predict_ahead(states, model.transition_matrix(dt), 25)
+    np.testing.assert_allclose(out[25:], states[25:], rtol=1e-12)
+
+
+def test_propagate_covariance_matches_hand_recursion_and_grows() -> None:
+    dt = 0.01
+    A, Q = model.transition_matrix(dt), model.process_noise_covariance(dt, 100.0)
+    P = propagate_covariance(np.eye(3), A, Q, 50)
+    assert P.shape == (51, 3, 3)
+    expected = np.eye(3)
+    for _ in range(50):
+        expected = A @ expected @ A.T + Q
+    np.testing.assert_allclose(P[-1], expected, rtol=1e-12)
+    assert np.all(np.diff(P[:, 0, 0]) > 0)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (
+            lambda: predict_ahead(np.zeros((5, 3)), np.eye(3), 5),
+            r"steps must be a whole number in \[0, 4\], got 5",
+        ),
+        (lambda: predict_ahead(np.zeros((5, 3)), np.eye(3), -1), "steps must be a whole number"),
+        (
+            lambda: predict_ahead(np.zeros((5, 3)), np.eye(2), 1),
+            r"A must have trailing shape \(3, 3\)",
+        ),
+        (
+            lambda: predict_ahead(np.full((5, 3), np.nan), np.eye(3), 1),
+            "estimates must contain only finite",
+        ),
+        (
+            lambda: propagate_covariance(-np.eye(3), np.eye(3), np.eye(3), 2),
+            "P0 must be positive semidefinite",
+        ),
+        (
+            lambda: propagate_covariance(np.eye(3), np.eye(3), np.eye(3), -2),
+            "steps must be a whole number >= 0",
+        ),
+    ],
+)
+def test_bad_input(call, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()

@@ -1,0 +1,62 @@
+"""The scenario object: derived values and validation."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from lqe_helpers import model
+from lqe_helpers.scenario import DEFAULT, Scenario, matched_jerk_std
+
+
+def test_defaults_make_the_delay_a_whole_number_of_steps() -> None:
+    assert DEFAULT.n_steps == 1000
+    assert DEFAULT.delay_steps(DEFAULT.delay) == 10
+    np.testing.assert_allclose(DEFAULT.times[:3], [0.0, 0.01, 0.02])
+    assert DEFAULT.burn_in_steps == 100
+
+
+def test_matched_jerk_std_equates_random_walk_and_sinusoid_spreads() -> None:
+    sigma = matched_jerk_std(10.0, 0.5, 0.01)
+    omega = np.pi
+    quarter_period = 0.5
+    # Random-walk spread of acceleration over a quarter period equals A ω².
+    assert np.sqrt(sigma**2 * 0.01 * quarter_period) == pytest.approx(10.0 * omega**2)
+    assert DEFAULT.process_jerk_std == pytest.approx(sigma)
+    np.testing.assert_allclose(DEFAULT.Q, model.process_noise_covariance(0.01, sigma))
+    assert replace(DEFAULT, jerk_std=5.0).process_jerk_std == 5.0
+
+
+def test_truth_is_the_sinusoid() -> None:
+    np.testing.assert_allclose(DEFAULT.truth[:, 0], 10 * np.sin(np.pi * DEFAULT.times))
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"dt": 0.0}, "dt must be a finite number > 0 s, got 0.0"),
+        ({"duration": 0.01}, "duration must be at least two time steps"),
+        ({"frequency": 60.0}, "frequency must be below the Nyquist limit"),
+        ({"delay": 0.105}, "delay must be a whole number of time steps dt = 0.01 s, got 0.105 s"),
+        ({"delay": -0.1}, "delay must be a finite number >= 0 s, got -0.1"),
+        ({"delay": 10.0}, r"delay must be shorter than the trial \(10.0 s\), got 10.0 s"),
+        ({"sigma_v": -1.5}, "sigma_v must be a finite number > 0 cm, got -1.5"),
+        ({"sigma_p": 0.0}, "sigma_p must be a finite number > 0 cm, got 0.0"),
+        ({"p0_variance": 0.0}, "p0_variance must be a finite number > 0 cm²"),
+        ({"jerk_std": -3.0}, "jerk_std must be a finite number > 0 cm/s³, got -3.0"),
+        ({"z0": (0.0, 0.0)}, r"z0 must hold 3 numbers \[p, v, a\]"),
+        ({"mc_runs": 1}, "mc_runs must be a whole number >= 2, got 1"),
+        ({"seed": -1}, "seed must be a whole number >= 0, got -1"),
+        ({"burn_in": 20.0}, "burn_in must be shorter than duration = 10.0 s, got 20.0"),
+    ],
+)
+def test_bad_values_are_refused(change: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        Scenario(**change)
+
+
+def test_unit_noise_refuses_unknown_sensors() -> None:
+    with pytest.raises(ValueError, match="sensors must be distinct names"):
+        DEFAULT.unit_noise(sensors=("touch",))

@@ -1,0 +1,105 @@
+"""Truth, noise draws, measurements and delays."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lqe_helpers import simulation
+from lqe_helpers.scenario import DEFAULT
+
+
+def test_sinusoid_states_are_exact_derivatives() -> None:
+    t = np.linspace(0.0, 3.0, 3001)
+    states = simulation.sinusoid_states(t, 10.0, 0.5)
+    # Central differences of the analytic position agree with the analytic v and a.
+    h = 1e-5
+    p = lambda s: simulation.sinusoid_states(s, 10.0, 0.5)[:, 0]  # noqa: E731
+    np.testing.assert_allclose((p(t + h) - p(t - h)) / (2 * h), states[:, 1], atol=1e-5)
+    np.testing.assert_allclose((p(t + h) - 2 * p(t) + p(t - h)) / h**2, states[:, 2], atol=1e-2)
+    np.testing.assert_allclose(states[0], [0.0, 10.0 * np.pi, 0.0], atol=1e-12)
+
+
+def test_unit_noise_is_standard_normal_and_independent_per_sensor() -> None:
+    noise = simulation.unit_noise(np.random.default_rng(1), 20_000, 2, runs=5)
+    assert noise.shape == (5, 20_000, 2)
+    flat = noise.reshape(-1, 2)
+    np.testing.assert_allclose(flat.mean(axis=0), 0.0, atol=0.01)
+    np.testing.assert_allclose(flat.std(axis=0), 1.0, atol=0.01)
+    assert abs(np.corrcoef(flat.T)[0, 1]) < 0.01
+
+
+def test_vision_noise_does_not_depend_on_other_sensors_or_run_count() -> None:
+    one = simulation.unit_noise(np.random.default_rng(3), 100, 1)
+    two = simulation.unit_noise(np.random.default_rng(3), 100, 2)
+    many = simulation.unit_noise(np.random.default_rng(3), 100, 2, runs=7)
+    np.testing.assert_array_equal(one[:, 0], two[:, 0])
+    np.testing.assert_array_equal(many[0], two)
+
+
+def test_measure_scales_the_fixed_draw_by_sigma() -> None:
+    positions = np.arange(5.0)
+    noise = np.ones((5, 2))
+    np.testing.assert_array_equal(
+        simulation.measure(positions, noise, [1.5, 4.5]),
+        np.stack([positions + 1.5, positions + 4.5], axis=-1),
+    )
+    sweep = simulation.measure(positions, noise, np.array([[1.0, 1.0], [2.0, 3.0]]))
+    assert sweep.shape == (2, 5, 2)
+    np.testing.assert_array_equal(sweep[1, :, 1], positions + 3.0)
+
+
+def test_delay_signal_shifts_and_pads_with_nan() -> None:
+    x = np.arange(12.0).reshape(6, 2)
+    out = simulation.delay_signal(x, 2)
+    assert np.all(np.isnan(out[:2]))
+    np.testing.assert_array_equal(out[2:], x[:4])
+    np.testing.assert_array_equal(simulation.delay_signal(x, 0), x)
+    trace = simulation.delay_signal(np.arange(4.0), 1, axis=-1)
+    np.testing.assert_array_equal(trace[1:], [0.0, 1.0, 2.0])
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: simulation.delay_signal(np.zeros((5, 1)), -1), "steps must be a whole number in"),
+        (
+            lambda: simulation.delay_signal(np.zeros((5, 1)), 5),
+            r"steps must be a whole number in \[0, 4\], got 5",
+        ),
+        (lambda: simulation.delay_signal(np.zeros((5, 1)), 1.5), "steps must be a whole number"),
+        (lambda: simulation.delay_signal(np.zeros(5), 1, axis=3), "axis must name an axis"),
+        (
+            lambda: simulation.unit_noise(np.random.RandomState(0), 5, 1),
+            "rng must be a numpy.random.Generator",
+        ),
+        (
+            lambda: simulation.unit_noise(np.random.default_rng(0), 0, 1),
+            "n_steps must be a whole number >= 1, got 0",
+        ),
+        (lambda: simulation.measure(np.zeros(4), np.zeros((5, 1)), [1.0]), "must agree on n and m"),
+        (
+            lambda: simulation.measure(np.zeros(5), np.zeros((5, 1)), [-1.0]),
+            "sigmas must all be > 0 cm",
+        ),
+        (
+            lambda: simulation.sinusoid_states(np.arange(3.0), 0.0, 1.0),
+            "amplitude must be a finite number > 0 cm",
+        ),
+        (
+            lambda: simulation.sinusoid_states([0.0, np.nan], 1.0, 1.0),
+            "times must contain only finite",
+        ),
+    ],
+)
+def test_bad_input(call, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()
+
+
+def test_scenario_noise_matches_between_single_run_and_monte_carlo() -> None:
+    single = DEFAULT.unit_noise()
+    batch = DEFAULT.unit_noise(runs=4)
+    np.testing.assert_array_equal(batch[0], single)
+    vision_only = DEFAULT.unit_noise(sensors=("vision",))
+    np.testing.assert_array_equal(vision_only[:, 0], single[:, 0])

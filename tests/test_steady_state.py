@@ -1,0 +1,75 @@
+"""The Riccati fixed point, against scipy and against running the recursion."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.linalg import solve_discrete_are
+
+from lqe_helpers import model
+from lqe_helpers.steady_state import steady_state
+
+
+@pytest.mark.parametrize("sigmas", [[1.5], [4.5], [1.5, 1.5], [1.5, 4.5], [1e-3], [1e3]])
+def test_matches_scipy_dare(sigmas: list[float]) -> None:
+    dt = 0.01
+    A = model.transition_matrix(dt)
+    Q = model.process_noise_covariance(dt, 1400.0)
+    C = model.observation_matrix(("vision", "proprioception")[: len(sigmas)])
+    R = model.measurement_noise_covariance(sigmas)
+    ours = steady_state(A, C, Q, R)
+    reference = solve_discrete_are(A.T, C.T, Q, R)
+    np.testing.assert_allclose(ours.covariance, reference, rtol=1e-7, atol=1e-12)
+    # It is a fixed point of Tutorial eq. (5)'s covariance line.
+    P = ours.covariance
+    S = C @ P @ C.T + R
+    again = A @ (P - P @ C.T @ np.linalg.solve(S, C @ P)) @ A.T + Q
+    np.testing.assert_allclose(again, P, rtol=1e-9)
+    np.testing.assert_allclose(ours.gain, P @ C.T @ np.linalg.inv(S), rtol=1e-9)
+
+
+def test_two_equal_sensors_equal_one_sensor_with_half_the_variance() -> None:
+    dt = 0.01
+    A, Q = model.transition_matrix(dt), model.process_noise_covariance(dt, 1400.0)
+    fused = steady_state(A, model.observation_matrix(("vision", "proprioception")), Q,
+                         model.measurement_noise_covariance([1.5, 1.5]))
+    single = steady_state(A, model.observation_matrix(), Q,
+                          model.measurement_noise_covariance([1.5 / np.sqrt(2)]))
+    np.testing.assert_allclose(fused.estimate_covariance, single.estimate_covariance, rtol=1e-9)
+
+
+def test_batched_r_gives_one_steady_state_each() -> None:
+    dt = 0.01
+    A, Q = model.transition_matrix(dt), model.process_noise_covariance(dt, 1400.0)
+    C = model.observation_matrix()
+    R = model.measurement_noise_covariance(np.array([[0.5], [1.5], [4.5]]))
+    batch = steady_state(A, C, Q, R)
+    assert batch.covariance.shape == (3, 3, 3)
+    for i in range(3):
+        np.testing.assert_allclose(batch.covariance[i], steady_state(A, C, Q, R[i]).covariance,
+                                   rtol=1e-12)
+    # More sensor noise, more estimation error.
+    assert np.all(np.diff(batch.estimate_covariance[:, 0, 0]) > 0)
+
+
+def test_unobservable_unstable_mode_is_reported() -> None:
+    A = np.diag([1.0, 1.1])  # the second state grows and nothing measures it
+    with pytest.raises(ValueError, match="no finite fixed point"):
+        steady_state(A, [[1.0, 0.0]], np.eye(2), [[1.0]])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"R": [[-1.0]]}, "R must be positive definite"),
+        ({"Q": [[1.0, 2.0, 0], [0, 1.0, 0], [0, 0, 1.0]]}, "Q must be symmetric"),
+        ({"C": [[1.0, 0.0]]}, r"C must have shape \(m, 3\)"),
+        ({"max_doublings": 0}, "max_doublings must be a whole number >= 1, got 0"),
+    ],
+)
+def test_bad_input(kwargs: dict, message: str) -> None:
+    args = {"A": model.transition_matrix(0.01), "C": [[1.0, 0.0, 0.0]],
+            "Q": model.process_noise_covariance(0.01, 1.0), "R": [[1.0]]}
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=message):
+        steady_state(**args)
