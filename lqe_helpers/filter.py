@@ -49,12 +49,18 @@ def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarra
                         R: np.ndarray, P0: np.ndarray) -> CovarianceSequence:
     """Run the gain and covariance lines of Tutorial eq. (5) for ``n_steps`` steps.
 
-    ``K_j = P_j Cᵀ (C P_j Cᵀ + R)⁻¹`` and ``P_{j+1} = A (P_j − K_j C P_j) Aᵀ + Q``.
-    The covariance update is evaluated in Joseph form,
-    ``P_{j+1} = M_j P_j M_jᵀ + (A K_j) R (A K_j)ᵀ + Q`` with ``M_j = A − A K_j C``:
-    equal to the tutorial's line for this optimal K, but a sum of positive
-    semidefinite terms, so P stays a covariance even for P0 = 10¹⁰ cm² against
-    σ = 10⁻³ cm where ``P − K C P`` would cancel to negative variances.
+    ``K_j = P_j Cᵀ (C P_j Cᵀ + R)⁻¹`` and ``P_{j+1} = A (P_j − K_j C P_j) Aᵀ + Q``,
+    evaluated in a numerically careful but algebraically identical way:
+
+    * the sensors are whitened with R's Cholesky factor L (``C_w = L⁻¹ C``, unit
+      noise) and their rows applied one scalar measurement at a time, so no nearly
+      singular ``C P Cᵀ + R`` is ever inverted (two sensors reading the same state
+      under a prior of 10¹⁰ cm² would lose ten digits in that inverse);
+    * each scalar update uses the Joseph form ``(I − g c) P (I − g c)ᵀ + g gᵀ``, a
+      sum of positive semidefinite terms, so P stays a covariance for P0 from
+      10⁻⁶ to 10¹⁰ cm² and σ from 10⁻³ to 10³ cm;
+    * the gain follows from the updated covariance, ``K = P⁺ Cᵀ R⁻¹``, which equals
+      ``P Cᵀ (C P Cᵀ + R)⁻¹``.
 
     Once P stops changing (every entry within 10⁻¹⁴ of its relative value, the
     Riccati fixed point to rounding) the remaining steps repeat the last gain
@@ -66,35 +72,37 @@ def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarra
     batch = np.broadcast_shapes(R.shape[:-2], P0.shape[:-2])
     k, m = A.shape[0], C.shape[0]
     R = np.broadcast_to(R, (*batch, m, m))
+    C_batch = np.broadcast_to(C, (*batch, m, k))
+    whitened = np.linalg.solve(np.linalg.cholesky(R), C_batch)       # L⁻¹ C
+    rows = [(whitened[..., i:i + 1, :], whitened[..., i:i + 1, :].mT) for i in range(m)]
+    ct_r_inv = np.linalg.solve(R, C_batch).mT                          # Cᵀ R⁻¹ (R symmetric)
     P = np.array(np.broadcast_to(P0, (*batch, k, k)))
-    C_T = C.T
+    identity = np.eye(k)
     # np.dot skips matmul's broadcasting machinery, which dominates 3×3 products.
     mul = np.dot if P.ndim == 2 else np.matmul
-    priors, gains = [], []
+    estimate_covariances, gains = [], []
     previous = P
     for j in range(n_steps):
-        PCt = mul(P, C_T)
-        K = mul(PCt, _inverse(mul(C, PCt) + R))
-        AK = mul(A, K)
-        M = A - mul(AK, C)
-        priors.append(P)
-        gains.append(K)
-        P = mul(mul(M, P), M.mT) + mul(mul(AK, R), AK.mT) + Q
+        for row, row_T in rows:
+            Pc = mul(P, row_T)
+            g = Pc / (mul(row, Pc) + 1.0)
+            L = identity - mul(g, row)
+            P = mul(mul(L, P), L.mT) + mul(g, g.mT)
+        estimate_covariances.append(P)
+        gains.append(mul(P, ct_r_inv))
+        P = mul(mul(A, P), A.T) + Q
         if j % _CONVERGENCE_CHECK_EVERY == 0:
             if np.allclose(P, previous, rtol=_CONVERGED_RTOL, atol=0.0):
                 break
             previous = P
     converged = len(gains)
-    priors = np.stack(priors, axis=-3)
-    priors = 0.5 * (priors + priors.mT)
+    estimate_covariances = np.stack(estimate_covariances, axis=-3)
     gains = np.stack(gains, axis=-3)
     if converged < n_steps:
         repeat = n_steps - converged
-        priors = np.concatenate([priors, _repeat_last(priors, repeat)], axis=-3)
+        estimate_covariances = np.concatenate(
+            [estimate_covariances, _repeat_last(estimate_covariances, repeat)], axis=-3)
         gains = np.concatenate([gains, _repeat_last(gains, repeat)], axis=-3)
-    # Vectorised over time: the covariance of ẑ_j and the P after y_j.
-    L = np.eye(k) - gains @ C
-    estimate_covariances = L @ priors @ L.mT + gains @ R[..., None, :, :] @ gains.mT
     estimate_covariances = 0.5 * (estimate_covariances + estimate_covariances.mT)
     covariances = A @ estimate_covariances @ A.T + Q
     covariances = 0.5 * (covariances + covariances.mT)
@@ -109,22 +117,6 @@ def _repeat_last(stack: np.ndarray, times: int) -> np.ndarray:
     """The last entry along axis -3 repeated ``times`` times."""
     last = stack[..., -1:, :, :]
     return np.broadcast_to(last, (*last.shape[:-3], times, *last.shape[-2:]))
-
-
-def _inverse(S: np.ndarray) -> np.ndarray:
-    """Inverse of a symmetric positive definite ``(..., m, m)`` innovation covariance.
-
-    The unbatched 1×1 and 2×2 cases (one or two sensors, the pack's models) use the
-    closed form: numpy's general inverse costs more in call overhead than the
-    arithmetic, and this line runs once per time step.
-    """
-    if S.shape == (1, 1):
-        return 1.0 / S
-    if S.shape == (2, 2):
-        (a, b), (c, d) = S.tolist()
-        det = a * d - b * c
-        return np.array([[d / det, -b / det], [-c / det, a / det]])
-    return np.linalg.inv(S)
 
 
 def kalman_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray,

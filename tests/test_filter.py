@@ -150,7 +150,7 @@ def test_filter_is_consistent_on_truth_from_its_own_model() -> None:
     assert np.all(np.abs(per_step - 3.0) < 5 * np.sqrt(6 / runs))
 
 
-@settings(max_examples=60, deadline=None)
+@settings(deadline=None)
 @given(
     p0=st.floats(min_value=1e-6, max_value=1e10),
     sigma_v=st.floats(min_value=1e-3, max_value=1e3),
@@ -173,12 +173,14 @@ def test_covariances_stay_symmetric_psd(p0, sigma_v, sigma_p, jerk, two_sensors)
         scale = np.max(np.abs(P), axis=(-2, -1))
         smallest = np.linalg.eigvalsh(P)[..., 0]
         assert np.all(smallest >= -1e-9 * scale), (name, smallest.min())
-        # The position variance after a measurement never exceeds the sensor's own variance
-        # (up to rounding): the filter can only gain from measuring.
-    assert np.all(out.estimate_covariances[:, 0, 0] <= min(sigmas) ** 2 * (1 + 1e-6) + 1e-12)
+    # The position variance after a measurement never exceeds the best sensor's variance
+    # (the filter can only gain from measuring), at every step, even with two sensors
+    # under a prior 10¹⁶ times wider than them.
+    posterior = out.estimate_covariances[:, 0, 0]
+    assert np.all(posterior <= min(sigmas) ** 2 * (1 + 1e-9))
 
 
-@settings(max_examples=30, deadline=None)
+@settings(deadline=None)
 @given(runs=st.integers(1, 3), n=st.integers(1, 12), k=st.integers(1, 4), m=st.integers(1, 3),
        seed=st.integers(0, 2**32 - 1))
 def test_output_shapes(runs: int, n: int, k: int, m: int, seed: int) -> None:
