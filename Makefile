@@ -12,7 +12,7 @@ CONSTRAINT_FLAG := $(if $(CONSTRAINTS),-c $(CONSTRAINTS),)
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: lab test lint notebooks clean
+.PHONY: lab test lint notebooks handouts student clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -35,6 +35,14 @@ test: $(STAMP) lint
 # Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
 notebooks: $(STAMP)
 	$(BIN)/python -m lqe_helpers.notebook_runner notebooks/*.ipynb
+
+# HTML handouts in build/handouts/ (index.html; prose/ without code), executed afresh.
+handouts: $(STAMP)
+	$(BIN)/python -m lqe_helpers.handouts --source notebooks --out build/handouts
+
+# Student edition in build/student/: solutions replaced by stubs, answers by prompts.
+student: $(STAMP)
+	$(BIN)/python -m lqe_helpers.student_edition --source notebooks --out build/student
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .ruff_cache .hypothesis lqe_course_pack.egg-info

@@ -23,10 +23,20 @@ import numpy as np
 
 from . import metrics, model, simulation, validation
 from .filter import FilterResult, kalman_filter
+from .prediction import propagate_covariance
 from .scenario import Scenario
 
 #: Column order of :func:`unit_noise`: vision's noise, then the acceleration signal's.
 NOISE_COLUMNS = ("vision", "acceleration")
+
+#: True bias b of the acceleration signal (cm/s²): a fifth of the hand's peak
+#: acceleration A(2πf)² ≈ 99 cm/s², enough to wreck dead reckoning within a second.
+DEFAULT_BIAS = 20.0
+#: Noise σ_a of each acceleration reading (cm/s²), also a fifth of the peak acceleration.
+DEFAULT_SIGMA_A = 20.0
+#: The filter's prior standard deviation of the bias (cm/s²): the observer allows
+#: offsets up to about half the peak acceleration before it has seen anything.
+DEFAULT_BIAS_PRIOR_STD = 50.0
 
 
 def transition_matrix(dt: float) -> np.ndarray:
@@ -96,7 +106,7 @@ def step_accelerations(scenario: Scenario) -> np.ndarray:
     ``(v(t_j) − v(t_j − Δt)) / Δt`` from the scenario's exact sinusoid: what an
     integrating acceleration sensor reports for that step. With it the noise-free,
     unbiased model of :func:`transition_matrix` and :func:`input_matrix` reproduces
-    the true velocity exactly and the position to within 10⁻⁵ cm over a trial.
+    the true velocity to rounding and the position to within 0.001 cm over a trial.
     """
     times = scenario.times
     now = simulation.sinusoid_states(times, scenario.amplitude, scenario.frequency)
@@ -122,7 +132,7 @@ def true_states(scenario: Scenario, bias: float) -> np.ndarray:
 
 
 def initial_state(scenario: Scenario, bias: float) -> np.ndarray:
-    """True state ``[p, v, b]`` at ``t = −Δt``, the time the filter's ``z0`` refers to, shape (3,)."""
+    """True state ``[p, v, b]`` at ``t = −Δt``, the time ``z0`` refers to, shape (3,)."""
     bias = _finite_number("bias", bias, "cm/s²")
     p, v, _ = simulation.sinusoid_states(np.array([-scenario.dt]), scenario.amplitude,
                                          scenario.frequency)[0]
@@ -221,6 +231,33 @@ def dead_reckoning(readings: np.ndarray, start: np.ndarray, dt: float,
     return out
 
 
+def bias_drift(scenario: Scenario, bias: float) -> np.ndarray:
+    """Position error (cm) of dead reckoning that ignores a bias b, shape (n,).
+
+    A constant error b in the acceleration, integrated twice from a perfectly known
+    start, displaces the position by ``b t² / 2`` (Lesson 0.5 eq. (1) with a = b),
+    where t is the time since the start, ``t_j + Δt`` at sample j (the start is
+    ``t = −Δt``). The discrete integration of :func:`dead_reckoning` gives exactly
+    this value at every sample.
+    """
+    bias = _finite_number("bias", bias, "cm/s²")
+    elapsed = scenario.times + scenario.dt
+    return bias * elapsed**2 / 2.0
+
+
+def dead_reckoning_spread(scenario: Scenario, sigma_a: float) -> np.ndarray:
+    """Standard deviation (cm) of dead reckoning's position from the signal's noise, (n,).
+
+    The covariance of Lesson 0.5 eq. (9), ``P(k+1) = F P Fᵀ + G σ_a² Gᵀ``, run from
+    ``P = 0`` at the known start: how far the dead-reckoned position wanders even
+    when the bias is known exactly. It grows roughly as ``σ_a √(Δt / 3) t^{3/2}``.
+    """
+    dt = scenario.dt
+    covariances = propagate_covariance(np.zeros((3, 3)), transition_matrix(dt),
+                                       process_noise_covariance(dt, sigma_a), scenario.n_steps)
+    return np.sqrt(covariances[1:, 0, 0])
+
+
 def unit_noise(scenario: Scenario, runs: int | None = None) -> np.ndarray:
     """Standard normal noise for vision and the acceleration signal, shape (..., n, 2).
 
@@ -308,8 +345,9 @@ class InputTracking:
                            self.scenario.burn_in_steps)
 
 
-def track_with_input(scenario: Scenario, bias: float = 20.0, sigma_a: float = 20.0,
-                     sigma_v: float | None = None, bias_prior_std: float = 50.0,
+def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
+                     sigma_a: float = DEFAULT_SIGMA_A, sigma_v: float | None = None,
+                     bias_prior_std: float = DEFAULT_BIAS_PRIOR_STD,
                      runs: int | None = None, noise: np.ndarray | None = None
                      ) -> InputTracking:
     """Simulate vision and the biased signal, then filter with the signal as input.

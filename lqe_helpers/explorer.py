@@ -16,6 +16,7 @@ from __future__ import annotations
 import base64
 import html
 import io
+import math
 from collections.abc import Callable, Mapping
 
 import ipywidgets as widgets
@@ -26,9 +27,23 @@ from matplotlib.figure import Figure
 DrawFunction = Callable[..., None]
 
 
+def _check_readout_format(readout_format: str) -> None:
+    """Reject readout formats the slider's text box cannot read back.
+
+    ipywidgets parses text typed into the readout with ``parseFloat``, which stops at
+    a thousands separator: "1,396" would be read as 1.
+    """
+    if "," in readout_format or "_" in readout_format:
+        raise ValueError(
+            f"readout_format must not group thousands (',' or '_'), got {readout_format!r}: "
+            "the slider could not read its own readout back"
+        )
+
+
 def float_slider(description: str, value: float, low: float, high: float, step: float,
                  readout_format: str = ".2f") -> widgets.FloatSlider:
     """A linear slider with the pack's conventions (symbol and unit, no live drag)."""
+    _check_readout_format(readout_format)
     return widgets.FloatSlider(
         value=value, min=low, max=high, step=step, description=description,
         readout_format=readout_format, continuous_update=False,
@@ -39,8 +54,7 @@ def float_slider(description: str, value: float, low: float, high: float, step: 
 def log_slider(description: str, value: float, low: float, high: float,
                steps_per_decade: int = 4, readout_format: str = ".3g") -> widgets.FloatLogSlider:
     """A base-10 logarithmic slider from ``low`` to ``high`` (e.g. P0 in cm²)."""
-    import math
-
+    _check_readout_format(readout_format)
     return widgets.FloatLogSlider(
         value=value, base=10, min=math.log10(low), max=math.log10(high),
         step=1.0 / steps_per_decade, description=description, readout_format=readout_format,
@@ -102,7 +116,9 @@ class Explorer:
         """Draw the figure for the current values and show it."""
         self.draw(self.figure, **self.values)
         buffer = io.BytesIO()
-        self.figure.savefig(buffer, format="png", dpi=self.dpi, metadata={"Software": None})
+        # Fast zlib level: encoding time matters more than bytes for a local widget.
+        self.figure.savefig(buffer, format="png", dpi=self.dpi, metadata={"Software": None},
+                            pil_kwargs={"compress_level": 1})
         self.png = buffer.getvalue()
         self.image.value = self.png
 

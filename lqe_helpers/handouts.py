@@ -148,16 +148,15 @@ class Page:
 
 
 def notebook_title(notebook: nbformat.NotebookNode, fallback: str) -> str:
-    """The text of the first markdown heading of ``notebook``, else ``fallback``."""
-    for cell in notebook.cells:
-        if cell.cell_type != "markdown":
-            continue
-        for line in cell.source.splitlines():
-            if line.startswith("#"):
-                title = line.lstrip("#").strip()
-                if title:
-                    return title
-    return fallback
+    """The notebook's first level-1 markdown heading, else its first heading, else ``fallback``."""
+    headings = [
+        line for cell in notebook.cells if cell.cell_type == "markdown"
+        for line in cell.source.splitlines() if line.startswith("#") and line.strip("# ")
+    ]
+    for line in headings:
+        if line.startswith("# "):
+            return line[2:].strip()
+    return headings[0].lstrip("#").strip() if headings else fallback
 
 
 def error_outputs(notebook: nbformat.NotebookNode) -> list[str]:
@@ -227,7 +226,9 @@ def _execute(path: Path) -> nbformat.NotebookNode:
     try:
         notebook = execute_notebook(path)
     except CellExecutionError as error:
-        raise HandoutBuildError(f"{path} raised while executing: {error}") from error
+        raise HandoutBuildError(
+            f"{path}: a cell raised {error.ename}: {error.evalue} (traceback above)"
+        ) from error
     errors = error_outputs(notebook)
     if errors:
         raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}")

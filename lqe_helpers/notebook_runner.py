@@ -16,6 +16,8 @@ from nbclient import NotebookClient
 
 #: Seconds one cell may run before the execution is abandoned.
 CELL_TIMEOUT = 300
+#: Output mimetype of a displayed ipywidget.
+WIDGET_VIEW_MIMETYPE = "application/vnd.jupyter.widget-view+json"
 
 
 def execute_notebook(path: Path | str, timeout: int = CELL_TIMEOUT,
@@ -34,7 +36,22 @@ def execute_notebook(path: Path | str, timeout: int = CELL_TIMEOUT,
     )
     client.execute()
     notebook.metadata.pop("widgets", None)
+    _stabilise_widget_ids(notebook)
     return notebook
+
+
+def _stabilise_widget_ids(notebook: nbformat.NotebookNode) -> None:
+    """Replace the random id of each saved widget view with one derived from its cell.
+
+    The id only names a widget model inside a live kernel session; saved to disk it
+    points at nothing, and a fresh random value on every run would make re-executed
+    notebooks differ for no reason.
+    """
+    for index, cell in enumerate(notebook.cells):
+        for output in cell.get("outputs", []):
+            view = output.get("data", {}).get(WIDGET_VIEW_MIMETYPE)
+            if view is not None:
+                view["model_id"] = f"saved-output-of-cell-{index}"
 
 
 def main(argv: list[str] | None = None) -> int:

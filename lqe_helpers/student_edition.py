@@ -108,7 +108,7 @@ def task_instruction(source: str) -> list[str]:
 
 def stub_source(source: str) -> str:
     """The student-edition stub for a solution cell: its task comment, then a raise."""
-    return "\n".join([*task_instruction(source), f"raise NotImplementedError({STUB_MESSAGE!r})"])
+    return "\n".join([*task_instruction(source), f'raise NotImplementedError("{STUB_MESSAGE}")'])
 
 
 def _tags(cell: nbformat.NotebookNode) -> list[str]:
@@ -146,6 +146,7 @@ class StudentEditionPreprocessor(Preprocessor):
         """Transform every cell, then insert the note on how to use the edition."""
         nb, resources = super().preprocess(nb, resources)
         note = nbformat.v4.new_markdown_cell(STUDENT_NOTE, metadata={"tags": [NOTE_TAG]})
+        note.id = NOTE_TAG  # a fixed id keeps the output identical from build to build
         nb.cells.insert(min(1, len(nb.cells)), note)
         return nb, resources
 

@@ -1,0 +1,215 @@
+"""Explorer of notebook 00: the jerk noise σ_j behind Q, open loop and in tracking.
+
+Left panel: how fast the position uncertainty grows once the measurements stop
+(Lesson 0.5 eq. (9) with no correction). Right panel: one tracking run at the same
+σ_j, to see the trade-off between lag (σ_j too small) and noise (σ_j too large).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from functools import lru_cache, partial
+
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+
+from .. import experiments, model, validation
+from ..explorer import Explorer, log_slider
+from ..plotting import COLORS, label_time_position, style
+from ..prediction import propagate_covariance
+from ..scenario import DEFAULT, Scenario
+from ..steady_state import steady_state
+
+#: Seconds of open-loop prediction drawn in the left panel.
+OPEN_LOOP_DURATION = 1.0
+#: Time window (s) of the tracking panel: two periods of the flight after the burn-in.
+TRACKING_WINDOW = (1.0, 5.0)
+#: Slider range of σ_j (cm/s³): two decades either side of the matched ≈ 1 400 cm/s³.
+JERK_STD_RANGE = (10.0, 1.0e5)
+
+#: Labels of the plotted artists, so tests and readers can find them.
+GROWTH_LABEL = "2σ at this σ_j"
+REFERENCE_LABEL = "2σ at the scenario's σ_j"
+AMPLITUDE_LABEL = "flight amplitude"
+VISION_LABEL = "vision"
+TRUTH_LABEL = "true path"
+ESTIMATE_LABEL = "filtered estimate"
+
+
+@dataclasses.dataclass(frozen=True)
+class OpenLoop:
+    """Prediction with no measurements from a known estimate and covariance.
+
+    Attributes
+    ----------
+    times : ndarray, shape (steps + 1,)
+        Time since the last measurement (s).
+    means : ndarray, shape (steps + 1, 3)
+        ``A^k ẑ``: where the observer expects the butterfly (cm, cm/s, cm/s²).
+    covariances : ndarray, shape (steps + 1, 3, 3)
+        ``P(k)`` from ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)).
+    """
+
+    times: np.ndarray
+    means: np.ndarray
+    covariances: np.ndarray
+
+    @property
+    def position_stds(self) -> np.ndarray:
+        """Standard deviation of the predicted position (cm), shape (steps + 1,)."""
+        return np.sqrt(self.covariances[:, 0, 0])
+
+
+def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
+              duration: float) -> OpenLoop:
+    """Predict ``duration`` s ahead with no measurements (Tutorial eq. (1) without noise).
+
+    The mean follows the model, ``ẑ(k+1) = A ẑ(k)``; the covariance grows as
+    ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)), with the scenario's A and Q.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies Δt, A and Q (through its σ_j).
+    estimate : array_like, shape (3,)
+        Estimate ``[p, v, a]`` when the measurements stop.
+    covariance : array_like, shape (3, 3)
+        Its covariance, e.g. the filter's ``estimate_covariances`` at that time, or
+        zeros for a perfectly known start.
+    duration : float
+        Prediction horizon in s, > 0.
+    """
+    estimate = validation.finite_array("estimate", estimate, min_ndim=1)
+    if estimate.shape != (3,):
+        raise ValueError(f"estimate must have shape (3,), got shape {estimate.shape}")
+    duration = validation.positive("duration", duration, "s")
+    steps = round(duration / scenario.dt)
+    covariances = propagate_covariance(covariance, scenario.A, scenario.Q, steps)
+    means = np.empty((steps + 1, 3))
+    means[0] = estimate
+    for k in range(steps):
+        means[k + 1] = scenario.A @ means[k]
+    return OpenLoop(np.arange(steps + 1) * scenario.dt, means, covariances)
+
+
+def steady_estimate_covariance(scenario: Scenario) -> np.ndarray:
+    """Covariance (3, 3) of the vision-only filter's estimate once it has settled.
+
+    What the observer knows about the butterfly after watching it for a while: the
+    starting point of an open-loop prediction in :func:`draw_background`.
+    """
+    C = model.observation_matrix(("vision",))
+    R = model.measurement_noise_covariance([scenario.sigma_v])
+    return steady_state(scenario.A, C, scenario.Q, R).estimate_covariance
+
+
+def format_jerk(jerk_std: float) -> str:
+    """σ_j as text: whole numbers from 100 cm/s³ up ("1,396"), 3 digits below ("31.6")."""
+    return f"{jerk_std:,.0f}" if jerk_std >= 100 else f"{jerk_std:.3g}"
+
+
+def amplitude_crossing(loop: OpenLoop, amplitude: float) -> float | None:
+    """First time (s) at which 2σ of the predicted position reaches ``amplitude`` (cm).
+
+    None if it stays below within the prediction's horizon.
+    """
+    above = 2 * loop.position_stds >= amplitude
+    return float(loop.times[np.argmax(above)]) if above.any() else None
+
+
+def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
+    crossing = amplitude_crossing(loop, amplitude)
+    return f"after {crossing:.2f} s" if crossing is not None else f"after > {loop.times[-1]:g} s"
+
+
+@lru_cache(maxsize=8)
+def _scenario_growth(scenario: Scenario) -> OpenLoop:
+    """Open-loop growth at the scenario's own σ_j: the reference curve, drawn once."""
+    return open_loop(scenario, np.zeros(3), steady_estimate_covariance(scenario),
+                     OPEN_LOOP_DURATION)
+
+
+def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEFAULT,
+                    noise: np.ndarray | None = None) -> None:
+    """Draw open-loop growth and tracking for the jerk noise ``jerk_std`` (cm/s³).
+
+    Clears ``figure``. Left: twice the standard deviation of the predicted position
+    when the measurements stop after the filter has settled (Lesson 0.5 eq. (9)),
+    at ``jerk_std`` and at the scenario's own σ_j, against the flight's amplitude.
+    Right: one vision-only tracking run with Q built from ``jerk_std``; the title
+    gives this run's MSE after the burn-in and the variance the filter expects.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        Cleared and redrawn.
+    jerk_std : float
+        σ_j behind Q in cm/s³, > 0.
+    scenario : Scenario
+        Everything else; its own σ_j is drawn as the reference curve.
+    noise : array_like, shape (n, 1), optional
+        Vision's unit noise; default the scenario's fixed draw.
+
+    Raises
+    ------
+    ValueError
+        If ``jerk_std`` is not a finite number > 0, or ``noise`` has the wrong shape.
+    """
+    jerk_std = validation.positive("jerk_std", jerk_std, "cm/s³")
+    variant = dataclasses.replace(scenario, jerk_std=jerk_std)
+    growth = open_loop(variant, np.zeros(3), steady_estimate_covariance(variant),
+                       OPEN_LOOP_DURATION)
+    reference = _scenario_growth(scenario)
+    tracking = experiments.track(variant, noise=noise)
+    times = scenario.times
+    window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
+    expected = float(np.mean(tracking.position_variances[scenario.burn_in_steps:]))
+
+    figure.clear()
+    growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
+    growth_ax.plot(reference.times, 2 * reference.position_stds,
+                   **style("reference", label=REFERENCE_LABEL))
+    growth_ax.plot(growth.times, 2 * growth.position_stds, **style("estimate", label=GROWTH_LABEL))
+    growth_ax.axhline(scenario.amplitude, color=COLORS["truth"], linewidth=0.8,
+                      linestyle="--", label=AMPLITUDE_LABEL)
+    growth_ax.set_yscale("log")
+    growth_ax.set_ylim(1e-2, 1e3)
+    # Decades only, as plain numbers: minor ticks and mathtext labels would double
+    # the time a slider move takes to render.
+    growth_ax.yaxis.set_major_locator(FixedLocator(np.logspace(-2, 3, 6)))
+    growth_ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    growth_ax.yaxis.set_minor_locator(NullLocator())
+    growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
+    growth_ax.set_xlabel("time since the last measurement (s)")
+    growth_ax.set_ylabel("2σ of predicted position (cm)")
+    growth_ax.set_title(f"σ_j = {format_jerk(jerk_std)} cm/s³: 2σ reaches "
+                        f"{scenario.amplitude:g} cm {_crossing_text(growth, scenario.amplitude)}",
+                        fontsize=10)
+    growth_ax.legend(loc="lower right", fontsize=8)
+
+    track_ax.plot(times[window], tracking.measurements[window, 0],
+                  **style("vision", label=VISION_LABEL))
+    track_ax.plot(times[window], scenario.truth[window, 0], **style("truth", label=TRUTH_LABEL))
+    track_ax.plot(times[window], tracking.positions[window],
+                  **style("estimate", label=ESTIMATE_LABEL))
+    track_ax.set_title(f"Tracking: MSE {float(tracking.mse()):.3g} cm², "
+                       f"filter expects {expected:.3g} cm²", fontsize=10)
+    track_ax.set_ylim(-1.7 * scenario.amplitude, 1.7 * scenario.amplitude)
+    track_ax.set_xlim(*TRACKING_WINDOW)
+    label_time_position(track_ax)
+    track_ax.legend(loc="upper center", fontsize=8, ncols=3)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.13, wspace=0.22)
+
+
+def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
+    """Slider for σ_j (log scale): open-loop growth and tracking respond together."""
+    noise = scenario.unit_noise(sensors=("vision",))
+    slider = log_slider("σ_j (cm/s³)", scenario.process_jerk_std, *JERK_STD_RANGE,
+                        steps_per_decade=8, readout_format=".0f")
+    return Explorer(
+        "Jerk noise σ_j: open-loop growth and tracking",
+        {"jerk_std": slider},
+        partial(draw_background, scenario=scenario, noise=noise),
+        figsize=(10.0, 4.2),
+    )

@@ -1,0 +1,191 @@
+"""Explorer of notebook 05: a sensory delay and its compensation by prediction.
+
+One slider sets the visual delay d. The figure shows, on the wall-clock time axis,
+what the observer has at each moment: the delayed noisy readings ``y_{j−δ}``, the
+filter's newest (delayed) estimate ``ẑ_{j−δ}`` and the compensated prediction
+``z*_j = A^δ ẑ_{j−δ}`` (Tutorial eqs. (7)–(8)), next to the true path, with the
+errors of both estimates in a panel below.
+"""
+
+from __future__ import annotations
+
+import math
+from functools import partial
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.patches import Patch
+
+from .. import experiments
+from ..explorer import Explorer, float_slider
+from ..plotting import COLORS, style
+from ..scenario import DEFAULT, Scenario
+
+#: Longest delay the slider offers (s): a quarter of the butterfly's period, far past
+#: the point where prediction stops paying off.
+MAX_DELAY = 0.5
+#: Seconds of the trial shown (s): the start, where nothing has arrived yet, and two
+#: periods of steady tracking. The MSEs in the title cover the whole trial after burn-in.
+WINDOW = 4.0
+
+#: The question's sensor: vision alone.
+SENSORS = ("vision",)
+
+# gid of each line → (axes index, role, legend label). The gids let tests find them.
+_LINES = {
+    "vision": (0, "vision", "vision, delayed  $y_{j-δ}$"),
+    "truth": (0, "truth", "true position"),
+    "delayed": (0, "estimate", "delayed estimate  $\\hat z_{j-δ}$"),
+    "prediction": (0, "prediction", "compensated  $z^*_j = A^δ\\,\\hat z_{j-δ}$"),
+    "delayed-error": (1, "estimate", "delayed estimate error"),
+    "prediction-error": (1, "prediction", "compensated error"),
+}
+_SPAN = "nothing-yet"
+_SPAN_STYLE = {"color": COLORS["vision"], "alpha": 0.2, "linewidth": 0, "gid": _SPAN,
+               "zorder": 0}
+
+
+def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
+               noise: np.ndarray | None = None) -> None:
+    """Draw one run of the delayed, compensated vision-only filter on ``figure``.
+
+    The top axes show the true position, the delayed visual readings, the delayed
+    estimate and the compensated prediction over the first :data:`WINDOW` s; a grey
+    band covers the first d seconds, when nothing has arrived yet. The bottom axes
+    show both estimates' errors (estimate − truth). The title gives this run's MSEs
+    (cm², over the whole trial after the burn-in or the delay, whichever is longer)
+    with and without compensation, and of the same filter with no delay.
+
+    A figure already drawn by this function for the same scenario keeps its axes and
+    only has its data replaced (redrawing axes from scratch costs more than the
+    100 ms a slider may take); any other figure is cleared first.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to draw on.
+    delay : float
+        Visual delay d in s, a whole number of time steps, ``0 <= d < duration``.
+    scenario : Scenario
+        Constants of the simulation (σ_v, Δt, the butterfly).
+    noise : array_like, shape (n, 1), optional
+        Unit noise of vision; default the scenario's fixed draw.
+
+    Raises
+    ------
+    ValueError
+        If ``delay`` is negative, not a multiple of Δt, or not shorter than the trial.
+    """
+    scenario.delay_steps(delay)  # validate before any work
+    if noise is None:
+        noise = scenario.unit_noise(sensors=SENSORS)
+    _draw_tracking(figure, delay, experiments.track(scenario, SENSORS, noise=noise))
+
+
+def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking) -> None:
+    """:func:`draw_delay` for a filter run already made (the delay only shifts it)."""
+    scenario = tracking.scenario
+    delayed = experiments.delay_and_compensate(tracking, delay)
+    steps = delayed.steps
+    mse_now = float(tracking.mse())
+    mse_delayed = float(delayed.mse("delayed"))
+    mse_predicted = float(delayed.mse("predicted"))
+
+    truth = scenario.truth[:, 0]
+    shown = scenario.times <= min(WINDOW, scenario.duration)
+    top, bottom = _layout(figure, scenario)
+    data = {
+        "vision": delayed.delayed_measurements[:, 0],
+        "truth": truth,
+        "delayed": delayed.delayed_estimates[:, 0],
+        "prediction": delayed.predictions[:, 0],
+        "delayed-error": delayed.delayed_estimates[:, 0] - truth,
+        "prediction-error": delayed.predictions[:, 0] - truth,
+    }
+    for ax in (top, bottom):
+        largest = 0.0
+        for line in ax.lines:
+            if line.get_gid() in data:
+                values = data[line.get_gid()][shown]
+                line.set_data(scenario.times[shown], values)
+                if np.any(np.isfinite(values)):
+                    largest = max(largest, float(np.nanmax(np.abs(values))))
+        # Fixed limits while everything fits, so small changes stay comparable; wider
+        # ones when a long extrapolation overshoots, so the overshoot stays visible.
+        floor = (1.5 if ax is top else 0.8) * scenario.amplitude
+        limit = max(floor, 1.08 * largest)
+        ax.set_ylim(-limit, limit)
+        for patch in [p for p in ax.patches if p.get_gid() == _SPAN]:
+            patch.remove()
+        if steps > 0:
+            ax.axvspan(0.0, steps * scenario.dt, **_SPAN_STYLE)
+    figure.suptitle(
+        f"delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps).   MSE of this run: "
+        f"delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
+        f"no delay {mse_now:.2f} cm²",
+        fontsize=9.5, y=0.985,
+    )
+
+
+def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes]:
+    """The two axes of :func:`draw_delay`, reused if ``figure`` holds them, else built."""
+    gids = (f"delay-signals-{hash(scenario)}", f"delay-errors-{hash(scenario)}")
+    if tuple(ax.get_gid() for ax in figure.axes) == gids:
+        return figure.axes[0], figure.axes[1]
+    figure.clear()
+    axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
+    figure.subplots_adjust(top=0.865, bottom=0.1, hspace=0.12)
+    for ax, gid in zip(axes, gids, strict=True):
+        ax.set_gid(gid)
+    handles = []
+    for gid, (index, role, label) in _LINES.items():
+        kwargs = {"linewidth": 1.2} if index == 1 else {}
+        (line,) = axes[index].plot([], [], **style(role, label=label, gid=gid, **kwargs))
+        if index == 0:
+            handles.append(line)
+    handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
+                         label="nothing has arrived yet"))
+    figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.945), ncol=5,
+                  fontsize=8, handlelength=2.2, columnspacing=1.2, markerscale=2.5)
+    top, bottom = axes
+    top.set_ylabel("position (cm)")
+    bottom.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
+    bottom.text(0.99, 0.95, "error = estimate − true position", transform=bottom.transAxes,
+                ha="right", va="top", fontsize=8)
+    bottom.set_xlabel("time (s)")
+    bottom.set_ylabel("error (cm)")
+    bottom.set_xlim(0.0, min(WINDOW, scenario.duration))
+    figure.align_ylabels(axes)
+    return top, bottom
+
+
+def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
+    """Slider for the visual delay d (s) over one fixed draw of vision noise.
+
+    The slider runs from 0 to :data:`MAX_DELAY` (or the last whole step before the
+    end of the trial, if that is shorter) in steps of Δt, starting at the scenario's
+    delay; a value between steps is rounded to the nearest step.
+    """
+    noise = scenario.unit_noise(sensors=SENSORS)
+    # A delay changes only when the filter's output arrives, not the output itself:
+    # filter the fixed noise once and let the slider shift and predict that run.
+    tracking = experiments.track(scenario, SENSORS, noise=noise)
+    high = math.floor(min(MAX_DELAY, (scenario.n_steps - 1) * scenario.dt) / scenario.dt
+                      + 1e-9) * scenario.dt
+    decimals = max(2, math.ceil(-math.log10(scenario.dt) - 1e-9))
+    slider = float_slider("delay (s)", value=min(scenario.delay, high), low=0.0, high=high,
+                          step=scenario.dt, readout_format=f".{decimals}f")
+    return Explorer(
+        "Sensory delay and its compensation: truth, delayed vision, delayed estimate and "
+        "prediction",
+        {"delay": slider},
+        partial(_draw_on_grid, tracking=tracking),
+        figsize=(9.0, 5.2),
+    )
+
+
+def _draw_on_grid(figure: Figure, *, delay: float, tracking: experiments.Tracking) -> None:
+    """Round the slider's float to the nearest whole step, then draw the fixed run."""
+    dt = tracking.scenario.dt
+    _draw_tracking(figure, round(delay / dt) * dt, tracking)

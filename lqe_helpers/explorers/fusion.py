@@ -1,0 +1,212 @@
+"""Explorer of question (c): vision alone against vision fused with proprioception.
+
+Two sliders set the noise of each sense. The left column shows one trial: the
+butterfly, both senses' readings and the two filters' estimates, with the
+estimation errors below. The right panel shows how the fused filter splits its
+trust between the senses once its gain has settled: the shares of the position
+correction, which follow the reliabilities ``1/σ_v²`` and ``1/σ_p²``.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from .. import experiments, validation
+from ..explorer import Explorer, float_slider
+from ..plotting import COLORS, plot_band, style
+from ..scenario import DEFAULT, Scenario
+
+#: The fused filter's sensors, in the column order of its noise and gains.
+FUSED = ("vision", "proprioception")
+
+#: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
+SIGMA_RANGE = (0.5, 6.0, 0.25)
+
+#: Plotted lines by gid: (panel, role, legend label or None).
+#: Panel 0 holds the signals, panel 1 the errors (estimate − true position).
+_LINES = {
+    "vision readings": (0, "vision", "vision readings"),
+    "proprioception readings": (0, "proprioception", "proprioception readings"),
+    "truth": (0, "truth", "true position"),
+    "vision-only": (0, "alternative", "vision-only estimate"),
+    "fused": (0, "estimate", "fused estimate"),
+    "vision-only error": (1, "alternative", None),
+    "fused error": (1, "estimate", None),
+}
+_BAND = "fused band"
+_BAND_LABEL = "fused filter's own ±2 SD"
+
+
+def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarray:
+    """Unit noise of vision (column 0) and proprioception (column 1), shape (n, 2).
+
+    ``noise`` is validated and returned; None gives the scenario's fixed draw.
+    """
+    if noise is None:
+        return scenario.unit_noise(sensors=FUSED)
+    noise = validation.finite_array("noise", noise, min_ndim=2)
+    expected = (scenario.n_steps, len(FUSED))
+    if noise.shape != expected:
+        raise ValueError(
+            f"noise must have shape {expected} (vision, proprioception), got shape {noise.shape}"
+        )
+    return noise
+
+
+def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
+                scenario: Scenario = DEFAULT, noise: np.ndarray | None = None) -> None:
+    """Draw vision-only and fused tracking of one trial at ``sigma_v`` and ``sigma_p``.
+
+    Both filters see the same visual readings; the fused one also sees proprioception
+    (C with two rows ``[1, 0, 0]``, ``R = diag(σ_v², σ_p²)``, Tutorial eq. (6)). Top
+    left: readings, true position and both estimates. Bottom left: both errors
+    (estimate − true position) with the fused filter's own ±2 SD band. Right: each
+    sense's share of the settled position gain. The title gives this trial's MSEs
+    after the scenario's burn-in.
+
+    A figure this function drew before (for the same scenario) keeps its panels and
+    only has its data replaced, which halves the redraw time of a slider; any other
+    figure is cleared first. The picture is the same either way.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        Figure to draw on.
+    sigma_v : float
+        Vision noise σ_v in cm, > 0.
+    sigma_p : float
+        Proprioception noise σ_p in cm, > 0.
+    scenario : Scenario
+        Butterfly, filter and simulation constants.
+    noise : array_like, shape (n, 2), optional
+        Unit noise of vision (column 0) and proprioception (column 1), scaled by the
+        σ's; default the scenario's fixed draw. The vision-only filter uses column 0.
+
+    Notes
+    -----
+    Lines carry a ``gid`` for tests: the keys of ``_LINES`` (``"vision readings"``,
+    ``"proprioception readings"``, ``"truth"``, ``"vision-only"``, ``"fused"``,
+    ``"vision-only error"``, ``"fused error"``); the bars ``"weight vision"`` and
+    ``"weight proprioception"``.
+
+    Raises
+    ------
+    ValueError
+        If a σ is not a finite number > 0, or ``noise`` has the wrong shape.
+    """
+    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
+    sigma_p = validation.positive("sigma_p", sigma_p, "cm")
+    noise = unit_noise(scenario, noise)
+    vision = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
+    fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
+    truth = scenario.truth[:, 0]
+    # Share of the position correction each sense receives once the gain has settled.
+    position_gain = fused.result.gains[-1, 0, :]
+    weights = position_gain / position_gain.sum()
+
+    signals, errors, shares = _layout(figure, scenario)
+    data = {
+        "vision readings": fused.measurements[:, 0],
+        "proprioception readings": fused.measurements[:, 1],
+        "truth": truth,
+        "vision-only": vision.positions,
+        "fused": fused.positions,
+        "vision-only error": vision.positions - truth,
+        "fused error": fused.positions - truth,
+    }
+    for ax in (signals, errors):
+        for line in ax.lines:
+            if line.get_gid() in data:
+                line.set_ydata(data[line.get_gid()])
+    for band in [c for c in errors.collections if c.get_gid() == _BAND]:
+        band.remove()
+    plot_band(errors, scenario.times, np.zeros(scenario.n_steps),
+              np.sqrt(fused.position_variances))
+    errors.collections[-1].set_gid(_BAND)
+    for bar, text, weight in zip(shares.patches, shares.texts, weights, strict=True):
+        bar.set_height(weight)
+        text.set_text(f"{100 * weight:.0f} %")
+        text.xy = (bar.get_x() + bar.get_width() / 2, weight)
+    figure.suptitle(
+        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
+        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
+        f"fused {float(fused.mse()):.3f} cm²",
+        x=0.07, y=0.985, ha="left", fontsize=10,
+    )
+
+
+def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
+    """The three panels of :func:`draw_fusion`, reused if ``figure`` holds them, else built."""
+    gids = tuple(f"fusion-{name}-{hash(scenario)}" for name in ("signals", "errors", "shares"))
+    if tuple(ax.get_gid() for ax in figure.axes) == gids:
+        return figure.axes[0], figure.axes[1], figure.axes[2]
+    figure.clear()
+    grid = figure.add_gridspec(2, 2, width_ratios=(3.4, 1.0), height_ratios=(1.6, 1.0),
+                               left=0.07, right=0.98, bottom=0.1, top=0.84,
+                               hspace=0.1, wspace=0.25)
+    signals = figure.add_subplot(grid[0, 0], gid=gids[0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals, gid=gids[1])
+    shares = figure.add_subplot(grid[:, 1], gid=gids[2])
+    times = scenario.times
+    panels = (signals, errors)
+    handles = []
+    for gid, (panel, role, label) in _LINES.items():
+        extra = {"linewidth": 1.0} if panel == 1 else {}
+        (line,) = panels[panel].plot(times, np.zeros_like(times),
+                                     **style(role, gid=gid, label=label, **extra))
+        if label is not None:
+            handles.append(line)
+    plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
+    handles.append(errors.collections[-1])
+    errors.collections[-1].set_gid(_BAND)
+    figure.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.07, 0.945), ncol=3,
+                  fontsize=8, markerscale=2.5)
+
+    limit = 1.7 * scenario.amplitude
+    signals.set_ylim(-limit, limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.axhline(0.0, **style("truth", linewidth=0.8))
+    errors.set_ylim(-3.5, 3.5)
+    errors.set_yticks([-2, 0, 2])
+    errors.set_xlim(0.0, scenario.duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels((signals, errors))
+
+    names = ("vision", "proprioception")
+    bars = shares.bar([0, 1], [0.5, 0.5], color=[COLORS[name] for name in names],
+                      edgecolor="black", linewidth=0.6)
+    for bar, name in zip(bars, names, strict=True):
+        bar.set_gid(f"weight {name}")
+        shares.annotate("", (bar.get_x() + bar.get_width() / 2, 0.5), xytext=(0, 3),
+                        textcoords="offset points", ha="center", fontsize=9)
+    shares.set_xticks([0, 1], ["vision", "proprio-\nception"])
+    shares.set_ylim(0.0, 1.1)
+    shares.set_yticks([0.0, 0.25, 0.5, 0.75, 1.0])
+    shares.set_ylabel("share of the position correction")
+    shares.set_title("weights ∝ reliability 1/σ²", fontsize=10)
+    return signals, errors, shares
+
+
+def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
+    """Sliders for σ_v and σ_p over vision-only and fused tracking of one fixed trial.
+
+    The unit noise is drawn once from the scenario and kept, so a slider changes
+    only how loud a sense is, never its noise pattern. The sliders start at the
+    scenario's σ_v and σ_p (question (c): 1.5 cm each), clipped into their range.
+    """
+    low, high, step = SIGMA_RANGE
+    sliders = {
+        "sigma_v": float_slider("σ_v (cm)", float(np.clip(scenario.sigma_v, low, high)),
+                                low, high, step),
+        "sigma_p": float_slider("σ_p (cm)", float(np.clip(scenario.sigma_p, low, high)),
+                                low, high, step),
+    }
+    draw = partial(draw_fusion, scenario=scenario, noise=unit_noise(scenario))
+    return Explorer("Vision alone against vision + proprioception", sliders, draw,
+                    figsize=(10.0, 5.0))

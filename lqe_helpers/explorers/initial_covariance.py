@@ -1,0 +1,191 @@
+"""Explorer of question (b): how the initial covariance P0 shapes the filter's start.
+
+One logarithmic slider sets P0 = p0_variance · I. The figure shows the first
+seconds of one run: position (truth, noisy vision, estimate) and velocity (truth,
+estimate), each estimate with the ±2σ band of the filter's own variance, so the
+reader sees both how fast the wrong initial guess is corrected and how confident
+the filter is while it is still wrong.
+
+Speed: as in :mod:`lqe_helpers.explorers.vision`, the panels are built once per
+figure and later calls replace the data, limits and title of the same artists; the
+picture equals a fresh drawing.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.text import Text
+from matplotlib.ticker import MultipleLocator
+
+from .. import experiments, metrics, validation
+from ..explorer import Explorer, log_slider
+from ..plotting import COLORS, style
+from ..scenario import DEFAULT, Scenario
+
+#: Slider range for P0 (cm², same number for cm²/s² and cm²/s⁴): from "certain of
+#: the initial guess" to "no idea at all".
+P0_RANGE = (1e-2, 1e6)
+#: Slider positions per decade of P0.
+P0_STEPS_PER_DECADE = 4
+#: Time shown (s): the start-up transient and a little of the steady state.
+WINDOW = 2.0
+
+#: Labels of the plotted artists, so tests and readers can find them. Both panels
+#: use the same labels: axes 0 is position, axes 1 velocity.
+TRUTH_LABEL = "truth"
+VISION_LABEL = "noisy vision"
+ESTIMATE_LABEL = "filtered estimate"
+BAND_LABEL = "±2σ of the filter's own variance"
+
+
+def shown_steps(scenario: Scenario) -> int:
+    """Number of samples drawn: the first :data:`WINDOW` seconds (or the whole trial)."""
+    return min(scenario.n_steps, round(WINDOW / scenario.dt) + 1)
+
+
+@dataclass(frozen=True)
+class _Panels:
+    """The artists :func:`draw_initial_covariance` built on one figure."""
+
+    scenario: Scenario
+    axes: tuple[Axes, Axes]
+    vision: Line2D
+    bands: tuple[FillBetweenPolyCollection, FillBetweenPolyCollection]
+    estimates: tuple[Line2D, Line2D]
+    title: Text
+
+    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
+        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
+        pairs = zip(self.axes, self.estimates, self.bands, strict=True)
+        return (self.scenario == scenario and figure.axes == list(self.axes)
+                and all(line in ax.lines and band in ax.collections
+                        for ax, line, band in pairs))
+
+
+#: Panels already built, by figure (weak: a figure that is gone frees its entry).
+_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
+
+
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Clear ``figure`` and build both panels' artists, with no data yet."""
+    figure.clear()
+    position_ax, velocity_ax = figure.subplots(1, 2)
+    times = scenario.times[:shown_steps(scenario)]
+    truth = scenario.truth[:times.size]
+    empty = np.zeros_like(times)
+    vision, = position_ax.plot(times, empty, label=VISION_LABEL, **style("vision"))
+    bands, estimates = [], []
+    for column, ax in enumerate((position_ax, velocity_ax)):
+        bands.append(ax.fill_between(times, empty, empty, color=COLORS["estimate"],
+                                     alpha=0.15, linewidth=0, label=BAND_LABEL))
+        ax.plot(times, truth[:, column], label=TRUTH_LABEL, **style("truth"))
+        estimates.append(ax.plot(times, empty, label=ESTIMATE_LABEL, **style("estimate"))[0])
+        ax.set_xlim(times[0], times[-1])
+        ax.xaxis.set_major_locator(MultipleLocator(0.5))  # fewer labels: faster redraws
+        ax.set_xlabel("time (s)")
+    position_ax.set_ylabel("position (cm)")
+    velocity_ax.set_ylabel("velocity (cm/s)")
+    speed = scenario.amplitude * 2.0 * np.pi * scenario.frequency
+    velocity_ax.set_ylim(-2.0 * speed, 2.0 * speed)
+    figure.legend(*position_ax.get_legend_handles_labels(), loc="lower center", ncol=4,
+                  fontsize=9, markerscale=3)
+    title = figure.suptitle("", fontsize=10)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.25, wspace=0.22)
+    return _Panels(scenario, (position_ax, velocity_ax), vision, tuple(bands),
+                   tuple(estimates), title)
+
+
+def draw_initial_covariance(figure: Figure, *, p0_variance: float,
+                            scenario: Scenario = DEFAULT,
+                            noise: np.ndarray | None = None) -> None:
+    """Draw the first :data:`WINDOW` seconds of one vision-only run with P0 = p0_variance · I.
+
+    Draws the whole figure, two panels side by side. Left: true position, noisy
+    vision and the estimated position. Right: true and estimated velocity. Each
+    estimate carries a band of ±2 standard deviations of the filter's own variance
+    (Tutorial eq. (5)). The velocity axis is fixed to twice the butterfly's top
+    speed, so a huge initial band or an overshooting estimate runs off the panel
+    instead of rescaling it. The title gives P0 and this run's position MSE before
+    and after the scenario's burn-in. A figure not drawn by this function is
+    cleared first; on one it drew before, the same artists receive the new data.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to draw on.
+    p0_variance : float
+        Diagonal entry of P0 = p0_variance · I, > 0 (cm² for position, cm²/s² for
+        velocity, cm²/s⁴ for acceleration).
+    scenario : Scenario
+        Every other constant; vision noise is ``scenario.sigma_v``.
+    noise : ndarray, shape (n, 1), optional
+        Unit vision noise; default the scenario's fixed draw.
+
+    Raises
+    ------
+    ValueError
+        If ``p0_variance`` is not a finite number > 0, or ``noise`` has the wrong shape.
+    """
+    p0_variance = validation.positive("p0_variance", p0_variance, "cm²")
+    tracking = experiments.track(scenario, ("vision",), p0_variance=p0_variance, noise=noise)
+    burn_in = scenario.burn_in_steps
+    early_mse = float(metrics.mse(tracking.positions[:burn_in], scenario.truth[:burn_in, 0]))
+    late_mse = float(tracking.mse())
+    shown = shown_steps(scenario)
+    measured = tracking.measurements[:shown, 0]
+    estimates = tracking.result.estimates[:shown]
+    variances = tracking.result.estimate_covariances[:shown]
+
+    panels = _PANELS.get(figure)
+    if panels is None or not panels.belong_to(figure, scenario):
+        panels = _PANELS[figure] = _build(figure, scenario)
+    times = scenario.times[:shown]
+    panels.vision.set_ydata(measured)
+    for column, (band, line) in enumerate(zip(panels.bands, panels.estimates, strict=True)):
+        std = np.sqrt(variances[:, column, column])
+        band.set_data(times, estimates[:, column] - 2 * std, estimates[:, column] + 2 * std)
+        line.set_ydata(estimates[:, column])
+    low = min(measured.min(), estimates[:, 0].min(), -scenario.amplitude)
+    high = max(measured.max(), estimates[:, 0].max(), scenario.amplitude)
+    margin = 0.05 * (high - low)
+    panels.axes[0].set_ylim(low - margin, high + margin)
+    panels.title.set_text(
+        f"P0 = {p0_variance:.3g} · I: position MSE of this run {early_mse:.2f} cm² in the "
+        f"first {scenario.burn_in:g} s, {late_mse:.2f} cm² after"
+    )
+
+
+def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
+    """Logarithmic slider for P0 (cm²) over :func:`draw_initial_covariance`.
+
+    The unit noise is drawn once from the scenario's seed and kept, so moving the
+    slider changes only P0, never the noise the filter sees.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Constants of the simulation; the slider starts at its ``p0_variance``
+        (clipped into the slider's range).
+
+    Returns
+    -------
+    Explorer
+        Display it in JupyterLab to get the live slider.
+    """
+    noise = scenario.unit_noise(sensors=("vision",))
+    low, high = P0_RANGE
+    slider = log_slider("P0 (cm²)", float(np.clip(scenario.p0_variance, low, high)), low, high,
+                        steps_per_decade=P0_STEPS_PER_DECADE, readout_format=".3g")
+    return Explorer(
+        "The start of vision-only tracking as the initial covariance P0 changes",
+        {"p0_variance": slider},
+        partial(draw_initial_covariance, scenario=scenario, noise=noise),
+    )

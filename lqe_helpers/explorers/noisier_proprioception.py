@@ -1,0 +1,219 @@
+"""Explorer of question (d): how much does a noisier proprioception still help vision?
+
+One slider sets σ_p while σ_v stays at the scenario's value. The left column shows
+one trial: the butterfly, the vision-only and the fused estimate, and their errors.
+The right panel places the slider's σ_p on the theoretical curve of the fused
+filter's steady-state position variance, below the vision-only level that the
+curve approaches but never crosses.
+"""
+
+from __future__ import annotations
+
+from functools import partial
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from .. import experiments, model, validation
+from ..explorer import Explorer, float_slider
+from ..plotting import COLORS, style
+from ..scenario import DEFAULT, Scenario
+from ..steady_state import steady_state
+from .fusion import FUSED, unit_noise
+
+#: σ_p (cm) of question (d), where the slider starts.
+QUESTION_SIGMA_P = 4.5
+
+#: Slider range for σ_p (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
+SIGMA_P_RANGE = (0.5, 30.0, 0.5)
+
+#: σ_p (cm) spanned by the theoretical curve in the right panel.
+CURVE_RANGE = (0.3, 100.0)
+
+#: Plotted lines by gid: (panel, role, legend label or None).
+#: Panel 0 holds the signals, panel 1 the errors (estimate − true position).
+_LINES = {
+    "truth": (0, "truth", "true position"),
+    "vision-only": (0, "alternative", "vision-only estimate"),
+    "fused": (0, "estimate", "fused estimate (vision + proprioception)"),
+    "vision-only error": (1, "alternative", None),
+    "fused error": (1, "estimate", None),
+}
+
+
+def steady_position_variances(scenario: Scenario, sigma_v: float,
+                              sigma_p: np.ndarray) -> tuple[float, np.ndarray]:
+    """Theoretical steady-state position variance (cm²) without and with proprioception.
+
+    The [0, 0] entry of ``(I − K∞ C) P∞`` (:func:`~lqe_helpers.steady_state.steady_state`)
+    for vision alone and for vision + proprioception (Tutorial eq. (6)).
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies A and Q.
+    sigma_v : float
+        Vision noise σ_v in cm, > 0.
+    sigma_p : array_like, shape (S,)
+        Proprioception noise values σ_p in cm, each > 0.
+
+    Returns
+    -------
+    vision_only : float
+        Steady-state position variance of the vision-only filter.
+    fused : ndarray, shape (S,)
+        The same for the fused filter at each σ_p (one batched Riccati solve).
+    """
+    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
+    sigma_p = validation.finite_array("sigma_p", sigma_p, min_ndim=1)
+    if sigma_p.ndim != 1 or np.any(sigma_p <= 0):
+        raise ValueError(
+            f"sigma_p must be a 1-D array of values > 0 cm, got {np.ravel(sigma_p)[:6].tolist()}"
+        )
+    alone = steady_state(scenario.A, model.observation_matrix(("vision",)), scenario.Q,
+                         model.measurement_noise_covariance([sigma_v]))
+    sigmas = np.stack([np.full_like(sigma_p, sigma_v), sigma_p], axis=-1)
+    both = steady_state(scenario.A, model.observation_matrix(FUSED), scenario.Q,
+                        model.measurement_noise_covariance(sigmas))
+    return float(alone.estimate_covariance[0, 0]), both.estimate_covariance[:, 0, 0]
+
+
+def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
+                                scenario: Scenario = DEFAULT,
+                                noise: np.ndarray | None = None) -> None:
+    """Draw one trial of vision-only and fused tracking at ``sigma_p`` on ``figure``.
+
+    Top left: true position and both estimates. Bottom left: both errors (estimate −
+    true position). Right: the fused filter's theoretical steady-state position
+    variance against σ_p (log axis), the vision-only level, and a marker at
+    ``sigma_p``, titled with proprioception's share of the settled position gain. The
+    figure's title gives this trial's MSEs after the scenario's burn-in.
+
+    A figure this function drew before (for the same scenario) keeps its panels and
+    only has its data replaced, which halves the redraw time of a slider; any other
+    figure is cleared first. The picture is the same either way.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        Figure to draw on.
+    sigma_p : float
+        Proprioception noise σ_p in cm, > 0. Vision keeps the scenario's σ_v.
+    scenario : Scenario
+        Butterfly, filter and simulation constants.
+    noise : array_like, shape (n, 2), optional
+        Unit noise of vision (column 0) and proprioception (column 1); default the
+        scenario's fixed draw. The vision-only filter uses column 0.
+
+    Notes
+    -----
+    Lines carry a ``gid`` for tests: ``"truth"``, ``"vision-only"``, ``"fused"``,
+    ``"vision-only error"``, ``"fused error"`` (left); ``"theory fused"`` (curve),
+    ``"theory vision-only"`` (level) and ``"theory now"`` (marker) on the right.
+
+    Raises
+    ------
+    ValueError
+        If ``sigma_p`` is not a finite number > 0, or ``noise`` has the wrong shape.
+    """
+    sigma_p = validation.positive("sigma_p", sigma_p, "cm")
+    noise = unit_noise(scenario, noise)
+    sigma_v = scenario.sigma_v
+    vision = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
+    fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
+    truth = scenario.truth[:, 0]
+    _, theory_now = steady_position_variances(scenario, sigma_v, np.array([sigma_p]))
+    # Proprioception's share of the position correction once the gain has settled.
+    position_gain = fused.result.gains[-1, 0, :]
+    weight_p = float(position_gain[1] / position_gain.sum())
+
+    signals, errors, theory = _layout(figure, scenario)
+    data = {
+        "truth": truth,
+        "vision-only": vision.positions,
+        "fused": fused.positions,
+        "vision-only error": vision.positions - truth,
+        "fused error": fused.positions - truth,
+    }
+    for ax in (signals, errors):
+        for line in ax.lines:
+            if line.get_gid() in data:
+                line.set_ydata(data[line.get_gid()])
+    (marker,) = [line for line in theory.lines if line.get_gid() == "theory now"]
+    marker.set_data([sigma_p], theory_now)
+    theory.set_title(f"steady state\nproprioception's weight: {100 * weight_p:.0f} %",
+                     fontsize=10)
+    figure.suptitle(
+        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
+        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², fused "
+        f"{float(fused.mse()):.3f} cm²",
+        x=0.07, y=0.985, ha="left", fontsize=10,
+    )
+
+
+def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
+    """The three panels of :func:`draw_noisier_proprioception`, reused or built."""
+    gids = tuple(f"noisier-proprioception-{name}-{hash(scenario)}"
+                 for name in ("signals", "errors", "theory"))
+    if tuple(ax.get_gid() for ax in figure.axes) == gids:
+        return figure.axes[0], figure.axes[1], figure.axes[2]
+    figure.clear()
+    grid = figure.add_gridspec(2, 2, width_ratios=(2.4, 1.0), height_ratios=(1.5, 1.0),
+                               left=0.07, right=0.98, bottom=0.1, top=0.86,
+                               hspace=0.1, wspace=0.3)
+    signals = figure.add_subplot(grid[0, 0], gid=gids[0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals, gid=gids[1])
+    theory = figure.add_subplot(grid[:, 1], gid=gids[2])
+    times = scenario.times
+    panels = (signals, errors)
+    handles = []
+    for gid, (panel, role, label) in _LINES.items():
+        extra = {"linewidth": 1.0} if panel == 1 else {}
+        (line,) = panels[panel].plot(times, np.zeros_like(times),
+                                     **style(role, gid=gid, label=label, **extra))
+        if label is not None:
+            handles.append(line)
+    figure.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.07, 0.945), ncol=3,
+                  fontsize=8)
+
+    limit = 1.4 * scenario.amplitude
+    signals.set_ylim(-limit, limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.axhline(0.0, **style("truth", linewidth=0.8))
+    errors.set_ylim(-2.5, 2.5)
+    errors.set_xlim(0.0, scenario.duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels((signals, errors))
+
+    curve_sigma = np.geomspace(*CURVE_RANGE, 120)
+    level, curve = steady_position_variances(scenario, scenario.sigma_v, curve_sigma)
+    theory.axhline(level, **style("alternative", gid="theory vision-only",
+                                  label="vision only"))
+    theory.plot(curve_sigma, curve, **style("estimate", gid="theory fused", label="fused"))
+    theory.plot([], [], gid="theory now", linestyle="none", marker="o", markersize=7,
+                color=COLORS["estimate"], label="slider's σ_p")
+    theory.set_xscale("log")
+    theory.set_xlim(*CURVE_RANGE)
+    theory.set_ylim(0.0, 1.15 * level)
+    theory.set_xlabel("σ_p (cm)")
+    theory.set_ylabel("steady-state position variance (cm²)")
+    theory.legend(loc="lower right", fontsize=8)
+    return signals, errors, theory
+
+
+def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
+    """A σ_p slider over vision-only and fused tracking of one fixed trial.
+
+    The unit noise is drawn once and kept, so moving σ_p rescales the same
+    proprioceptive noise pattern; vision's readings never change. The slider starts
+    at question (d)'s σ_p = 4.5 cm; σ_v is the scenario's.
+    """
+    low, high, step = SIGMA_P_RANGE
+    sliders = {"sigma_p": float_slider("σ_p (cm)", QUESTION_SIGMA_P, low, high, step,
+                                       readout_format=".1f")}
+    draw = partial(draw_noisier_proprioception, scenario=scenario, noise=unit_noise(scenario))
+    return Explorer("How much does a noisier proprioception help?", sliders, draw,
+                    figsize=(10.0, 5.0))

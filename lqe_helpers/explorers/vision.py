@@ -1,0 +1,158 @@
+"""Explorer of question (a): how well vision alone lets the filter follow the butterfly.
+
+One slider sets the vision noise σ_v. The figure shows the true path, the noisy
+visual samples and the filter's estimate with the ±2σ band of its own position
+variance, for one fixed noise pattern scaled by σ_v.
+
+Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
+filter run, so :func:`draw_vision` builds the panel once per figure and afterwards
+only replaces the data, limits and title of the same artists. The picture is the
+same as a fresh drawing (a test checks the PNG bytes); only the redraw is faster.
+"""
+
+from __future__ import annotations
+
+import weakref
+from dataclasses import dataclass
+from functools import partial
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from .. import experiments, validation
+from ..explorer import Explorer, float_slider
+from ..plotting import COLORS, label_time_position, style
+from ..scenario import DEFAULT, Scenario
+
+#: Slider range for σ_v (cm): from a nearly perfect eye to noise as large as the flight.
+SIGMA_V_RANGE = (0.1, 10.0)
+#: Slider step for σ_v (cm).
+SIGMA_V_STEP = 0.1
+
+#: Labels of the plotted artists, so tests and readers can find them.
+TRUTH_LABEL = "true position"
+VISION_LABEL = "noisy vision"
+ESTIMATE_LABEL = "filtered estimate"
+BAND_LABEL = "±2σ of the filter's own variance"
+
+
+@dataclass(frozen=True)
+class _Panel:
+    """The artists :func:`draw_vision` built on one figure, reused by later calls."""
+
+    scenario: Scenario
+    ax: Axes
+    vision: Line2D
+    band: FillBetweenPolyCollection
+    estimate: Line2D
+
+    def belongs_to(self, figure: Figure, scenario: Scenario) -> bool:
+        """True if ``figure`` still shows exactly this panel, for ``scenario``."""
+        return (self.scenario == scenario and figure.axes == [self.ax]
+                and self.estimate in self.ax.lines and self.band in self.ax.collections)
+
+
+#: Panels already built, by figure (weak: a figure that is gone frees its entry).
+_PANELS: weakref.WeakKeyDictionary[Figure, _Panel] = weakref.WeakKeyDictionary()
+
+
+def _build(figure: Figure, scenario: Scenario) -> _Panel:
+    """Clear ``figure`` and build the artists, with no data yet."""
+    figure.clear()
+    ax = figure.add_subplot()
+    times = scenario.times
+    vision, = ax.plot(times, np.zeros_like(times), label=VISION_LABEL, **style("vision"))
+    band = ax.fill_between(times, times, times, color=COLORS["estimate"], alpha=0.15,
+                           linewidth=0, label=BAND_LABEL)
+    ax.plot(times, scenario.truth[:, 0], label=TRUTH_LABEL, **style("truth"))
+    estimate, = ax.plot(times, np.zeros_like(times), label=ESTIMATE_LABEL, **style("estimate"))
+    ax.set_xlim(0.0, scenario.duration)
+    label_time_position(ax)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4, fontsize=9,
+              markerscale=3)
+    figure.subplots_adjust(left=0.08, right=0.98, top=0.91, bottom=0.27)
+    return _Panel(scenario, ax, vision, band, estimate)
+
+
+def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
+                noise: np.ndarray | None = None) -> None:
+    """Draw one vision-only tracking run at vision noise ``sigma_v`` on ``figure``.
+
+    Draws the whole figure: the true position, the noisy visual measurements
+    (Tutorial eq. (3)), the filtered estimate (Tutorial eq. (5)) and a band of ±2
+    standard deviations of the filter's own position variance. The title gives σ_v
+    and this run's mean squared error of the raw and the filtered signal after the
+    scenario's burn-in. A figure not drawn by this function is cleared first; on
+    one it drew before, the same artists receive the new data.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to draw on.
+    sigma_v : float
+        Vision noise standard deviation σ_v in cm, > 0; both the true noise level
+        and the one the filter assumes in R.
+    scenario : Scenario
+        Every other constant (Δt, the flight, Q, z0, P0, burn-in).
+    noise : ndarray, shape (n, 1), optional
+        Unit noise scaled by σ_v; default the scenario's fixed vision draw.
+
+    Raises
+    ------
+    ValueError
+        If ``sigma_v`` is not a finite number > 0, or ``noise`` has the wrong shape.
+    """
+    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
+    tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise)
+    measured = tracking.measurements[:, 0]
+    estimate = tracking.positions
+    std = np.sqrt(tracking.position_variances)
+    raw_mse = float(tracking.measurement_mse("vision"))
+    filtered_mse = float(tracking.mse())
+
+    panel = _PANELS.get(figure)
+    if panel is None or not panel.belongs_to(figure, scenario):
+        panel = _PANELS[figure] = _build(figure, scenario)
+    panel.vision.set_ydata(measured)
+    panel.band.set_data(scenario.times, estimate - 2 * std, estimate + 2 * std)
+    panel.estimate.set_ydata(estimate)
+    low = min(measured.min(), (estimate - 2 * std).min(), -scenario.amplitude)
+    high = max(measured.max(), (estimate + 2 * std).max(), scenario.amplitude)
+    margin = 0.05 * (high - low)
+    panel.ax.set_ylim(low - margin, high + margin)
+    panel.ax.set_title(
+        f"σ_v = {sigma_v:.1f} cm: MSE after {scenario.burn_in:g} s, this run: "
+        f"raw vision {raw_mse:.2f} cm², filtered {filtered_mse:.2f} cm²",
+        fontsize=10,
+    )
+
+
+def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
+    """Slider for σ_v (cm) over :func:`draw_vision`, with one fixed noise pattern.
+
+    The unit noise is drawn once from the scenario's seed and kept, so moving the
+    slider rescales the same noise instead of drawing new noise.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Constants of the simulation; the slider starts at its ``sigma_v`` (clipped
+        into the slider's range).
+
+    Returns
+    -------
+    Explorer
+        Display it in JupyterLab to get the live slider.
+    """
+    noise = scenario.unit_noise(sensors=("vision",))
+    low, high = SIGMA_V_RANGE
+    slider = float_slider("σ_v (cm)", float(np.clip(scenario.sigma_v, low, high)), low, high,
+                          SIGMA_V_STEP, readout_format=".1f")
+    return Explorer(
+        "Vision-only tracking as the vision noise σ_v changes",
+        {"sigma_v": slider},
+        partial(draw_vision, scenario=scenario, noise=noise),
+    )

@@ -1,0 +1,56 @@
+"""The HTML handouts work offline: every image loads with the network cut.
+
+The handouts are built afresh from ``notebooks/`` (with code, and the prose variant)
+and each page is opened from disk in Chromium with no network. Every image must load,
+nothing but a script (MathJax, which the pages load asynchronously and can do
+without) may try to reach the network, and every link to a local page must exist.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from lab_driver import NOTEBOOK_DIR, course_notebooks, screenshot_path
+from offline_pages import OfflinePage, open_offline
+
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
+
+
+@pytest.fixture(scope="session")
+def handout_pages(chromium_executable: str, tmp_path_factory: pytest.TempPathFactory
+                  ) -> list[Path]:
+    from lqe_helpers.handouts import build_handouts
+
+    out_dir = tmp_path_factory.mktemp("handouts")
+    written = build_handouts(NOTEBOOK_DIR, out_dir)
+    found = sorted(out_dir.rglob("*.html"))
+    assert sorted(written) == found, "build_handouts did not list every page it wrote"
+    return found
+
+
+def describe(page: OfflinePage, root: Path) -> str:
+    lines = [f"{page.path.relative_to(root)}:"]
+    lines += [f"  image not loaded: src={image['src']!r} alt={image['alt']!r}"
+              for image in page.broken_images]
+    return "\n".join(lines)
+
+
+def test_every_handout_image_loads_offline(browser, handout_pages: list[Path]) -> None:
+    root = handout_pages[0].parent
+    pages = [open_offline(browser, path, screenshot_path(
+                 "handout-" + "-".join(path.relative_to(root).with_suffix("").parts)))
+             for path in handout_pages]
+    stems = {path.stem for path in course_notebooks()}
+    assert {page.path.stem for page in pages} >= stems | {"index"}, "a notebook has no handout"
+
+    broken = [describe(page, root) for page in pages if page.broken_images]
+    assert not broken, "images that do not load offline:\n" + "\n".join(broken)
+
+    for page in pages:
+        if page.path.stem in stems:
+            assert page.images, f"{page.path.relative_to(root)} shows no image at all"
+        remote = [request for request in page.blocked if not request.startswith("script ")]
+        assert not remote, f"{page.path.relative_to(root)} needs the network for: {remote}"
+        missing = [str(link) for link in page.local_links if not link.is_file()]
+        assert not missing, f"{page.path.relative_to(root)} links to missing pages: {missing}"

@@ -1,0 +1,180 @@
+"""The σ_j explorer of notebook 00 draws exactly what the engine computes."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from lqe_helpers import experiments, model
+from lqe_helpers.explorers import background
+from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.steady_state import steady_state
+
+
+def line(ax: Axes, label: str) -> np.ndarray:
+    """y data of the one line labelled ``label``."""
+    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
+    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
+    return np.asarray(found[0].get_ydata(), float)
+
+
+def direct_growth(jerk_std: float, steps: int = 100) -> np.ndarray:
+    """2σ of the open-loop position, straight from Lesson 0.5 eq. (9) in a loop."""
+    scenario = dataclasses.replace(DEFAULT, jerk_std=jerk_std)
+    A = model.transition_matrix(DEFAULT.dt)
+    Q = model.process_noise_covariance(DEFAULT.dt, jerk_std)
+    P = steady_state(A, model.observation_matrix(("vision",)), scenario.Q,
+                     model.measurement_noise_covariance([DEFAULT.sigma_v])).estimate_covariance
+    out = [P[0, 0]]
+    for _ in range(steps):
+        P = A @ P @ A.T + Q
+        out.append(P[0, 0])
+    return 2 * np.sqrt(np.array(out))
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return background.explore_background()
+
+
+def window() -> np.ndarray:
+    low, high = background.TRACKING_WINDOW
+    return (DEFAULT.times >= low) & (DEFAULT.times <= high)
+
+
+def test_slider_follows_the_conventions(explorer) -> None:
+    slider = explorer.sliders["jerk_std"]
+    assert slider.description == "σ_j (cm/s³)"
+    low, high = background.JERK_STD_RANGE
+    assert (slider.min, slider.max) == (math.log10(low), math.log10(high))
+    assert slider.base == 10
+    assert slider.value == pytest.approx(DEFAULT.process_jerk_std)
+    assert slider.continuous_update is False
+    assert low < DEFAULT.process_jerk_std < high
+
+
+@pytest.mark.parametrize("jerk_std", [10.0, 100.0, 30000.0, 1.0e5])
+def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: float) -> None:
+    previous_png = explorer.png
+    explorer.sliders["jerk_std"].value = jerk_std
+    growth_ax, track_ax = explorer.figure.axes
+    np.testing.assert_allclose(line(growth_ax, background.GROWTH_LABEL),
+                               direct_growth(jerk_std), rtol=1e-9)
+    np.testing.assert_allclose(line(growth_ax, background.REFERENCE_LABEL),
+                               direct_growth(DEFAULT.process_jerk_std), rtol=1e-9)
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    shown = window()
+    truth = DEFAULT.truth[:, 0]
+    np.testing.assert_allclose(line(track_ax, background.VISION_LABEL),
+                               (truth + DEFAULT.sigma_v * noise[:, 0])[shown], atol=1e-12)
+    np.testing.assert_array_equal(line(track_ax, background.TRUTH_LABEL), truth[shown])
+    expected = experiments.track(dataclasses.replace(DEFAULT, jerk_std=jerk_std), noise=noise)
+    np.testing.assert_allclose(line(track_ax, background.ESTIMATE_LABEL),
+                               expected.positions[shown], rtol=0, atol=1e-12)
+    assert f"MSE {float(expected.mse()):.3g} cm²" in track_ax.get_title()
+    assert f"σ_j = {background.format_jerk(jerk_std)} cm/s³" in growth_ax.get_title()
+    assert explorer.png != previous_png
+
+
+def test_title_gives_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
+    explorer.sliders["jerk_std"].value = DEFAULT.process_jerk_std
+    growth = direct_growth(DEFAULT.process_jerk_std)
+    first = int(np.argmax(growth >= DEFAULT.amplitude))
+    assert first > 0
+    growth_ax = explorer.figure.axes[0]
+    assert f"after {first * DEFAULT.dt:.2f} s" in growth_ax.get_title()
+    # Very small σ_j: never within the second shown.
+    explorer.sliders["jerk_std"].value = 10.0
+    assert "after > 1 s" in explorer.figure.axes[0].get_title()
+
+
+def test_lag_and_noise_show_in_the_tracking_error(explorer) -> None:
+    """Too small σ_j: large, overconfident error; matched σ_j: much smaller."""
+    mses = {}
+    for jerk_std in (10.0, DEFAULT.process_jerk_std, 1.0e5):
+        explorer.sliders["jerk_std"].value = jerk_std
+        track_ax = explorer.figure.axes[1]
+        error = line(track_ax, background.ESTIMATE_LABEL) - DEFAULT.truth[window(), 0]
+        mses[jerk_std] = np.mean(error**2)
+    assert mses[DEFAULT.process_jerk_std] < mses[1.0e5] < mses[10.0]
+
+
+def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
+    estimates, visions = [], []
+    for jerk_std in (300.0, 3000.0, 300.0):
+        explorer.sliders["jerk_std"].value = jerk_std
+        track_ax = explorer.figure.axes[1]
+        estimates.append(line(track_ax, background.ESTIMATE_LABEL))
+        visions.append(line(track_ax, background.VISION_LABEL))
+    np.testing.assert_array_equal(visions[0], visions[1])
+    np.testing.assert_array_equal(estimates[0], estimates[2])
+    assert not np.array_equal(estimates[0], estimates[1])
+    explorer.sliders["jerk_std"].value = DEFAULT.process_jerk_std
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
+    figure = Figure()
+    noise = np.zeros((DEFAULT.n_steps, 1))
+    background.draw_background(figure, jerk_std=500.0, noise=noise)
+    growth_ax, track_ax = figure.axes
+    np.testing.assert_allclose(line(growth_ax, background.GROWTH_LABEL), direct_growth(500.0),
+                               rtol=1e-9)
+    shown = window()
+    np.testing.assert_array_equal(line(track_ax, background.VISION_LABEL),
+                                  DEFAULT.truth[shown, 0])
+    expected = experiments.track(dataclasses.replace(DEFAULT, jerk_std=500.0), noise=noise)
+    np.testing.assert_allclose(line(track_ax, background.ESTIMATE_LABEL),
+                               expected.positions[shown], rtol=0, atol=1e-12)
+    # Drawing again replaces, not adds.
+    background.draw_background(figure, jerk_std=800.0, noise=noise)
+    assert len(figure.axes) == 2
+    assert len(figure.axes[1].get_lines()) == 3
+
+
+def test_open_loop_follows_the_model() -> None:
+    estimate = np.array([1.0, -20.0, 50.0])
+    P = np.diag([0.5, 4.0, 100.0])
+    loop = background.open_loop(DEFAULT, estimate, P, 0.2)
+    assert loop.times.shape == (21,)
+    A = DEFAULT.A
+    np.testing.assert_allclose(loop.means[-1], np.linalg.matrix_power(A, 20) @ estimate)
+    # Constant acceleration from the start: p = p0 + v t + a t² / 2 exactly.
+    t = loop.times
+    np.testing.assert_allclose(loop.means[:, 0], 1.0 - 20.0 * t + 25.0 * t**2, atol=1e-12)
+    expected = P
+    for _ in range(20):
+        expected = A @ expected @ A.T + DEFAULT.Q
+    np.testing.assert_allclose(loop.covariances[-1], expected, rtol=1e-12)
+    assert np.all(np.diff(loop.position_stds) > 0)
+
+
+def test_open_loop_from_a_known_start_grows_as_t_to_five_halves() -> None:
+    loop = background.open_loop(DEFAULT, np.zeros(3), np.zeros((3, 3)), 1.0)
+    t, std = loop.times[50:], loop.position_stds[50:]
+    slope = np.polyfit(np.log(t), np.log(std), 1)[0]
+    assert slope == pytest.approx(2.5, abs=0.02)
+
+
+@pytest.mark.parametrize("bad", [0.0, -10.0, np.nan, np.inf])
+def test_bad_jerk_std_is_rejected_by_name(bad: float) -> None:
+    with pytest.raises(ValueError, match="jerk_std"):
+        background.draw_background(Figure(), jerk_std=bad)
+
+
+def test_bad_open_loop_input_is_rejected_by_name() -> None:
+    with pytest.raises(ValueError, match="estimate"):
+        background.open_loop(DEFAULT, np.zeros(2), np.eye(3), 1.0)
+    with pytest.raises(ValueError, match="duration"):
+        background.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.0)
+
+
+def test_static_display_carries_the_picture(explorer) -> None:
+    bundle = explorer._repr_mimebundle_()
+    assert bundle["text/plain"].startswith("Interactive explorer")
+    assert "σ_j (cm/s³)" in bundle["text/html"]
+    assert explorer.png.startswith(b"\x89PNG")

@@ -1,0 +1,182 @@
+"""The bias explorer of notebook 06 draws exactly what the engine computes."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from lqe_helpers import bias_model, model
+from lqe_helpers.explorers import bias as bias_explorer
+from lqe_helpers.filter import kalman_filter
+from lqe_helpers.scenario import DEFAULT
+
+SHOWN = DEFAULT.times <= bias_explorer.WINDOW
+
+
+def line(ax: Axes, label: str) -> np.ndarray:
+    """y data of the one line labelled ``label``."""
+    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
+    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
+    return np.asarray(found[0].get_ydata(), float)
+
+
+def band_edges(ax: Axes, label: str) -> np.ndarray:
+    """Vertices (x, y) of the filled band labelled ``label``."""
+    found = [c for c in ax.collections if c.get_label() == label]
+    assert len(found) == 1, f"expected one band labelled {label!r}, got {len(found)}"
+    return np.concatenate([path.vertices for path in found[0].get_paths()])
+
+
+def direct_filter(bias: float, sigma_a: float, sigma_v: float, noise: np.ndarray):
+    """The experiment assembled by hand from Lesson 0.5 eqs. (5) and (9)."""
+    dt = DEFAULT.dt
+    readings = (bias_model.step_accelerations(DEFAULT) + bias + sigma_a * noise[:, 1])
+    y = DEFAULT.truth[:, :1] + sigma_v * noise[:, :1]
+    F = np.array([[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
+    G = np.array([[dt**2 / 2], [dt], [0]])
+    speed = DEFAULT.amplitude * 2 * np.pi * DEFAULT.frequency
+    P0 = np.diag([DEFAULT.amplitude**2, speed**2, bias_model.DEFAULT_BIAS_PRIOR_STD**2])
+    return kalman_filter(y, F, model.observation_matrix(("vision",)), G @ G.T * sigma_a**2,
+                         np.array([[sigma_v**2]]), np.zeros(3), P0, B=G, u=readings[:, None])
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return bias_explorer.explore_bias()
+
+
+def test_sliders_follow_the_conventions(explorer) -> None:
+    b, sigma_a, sigma_v = (explorer.sliders[name] for name in ("bias", "sigma_a", "sigma_v"))
+    assert b.description == "b (cm/s²)"
+    assert (b.min, b.max, b.step) == (*bias_explorer.BIAS_RANGE, bias_explorer.BIAS_STEP)
+    assert b.value == bias_model.DEFAULT_BIAS
+    assert sigma_a.description == "σ_a (cm/s²)"
+    low, high = bias_explorer.SIGMA_A_RANGE
+    assert (sigma_a.min, sigma_a.max, sigma_a.base) == (math.log10(low), math.log10(high), 10)
+    assert low > 0
+    assert sigma_a.value == pytest.approx(bias_model.DEFAULT_SIGMA_A)
+    assert sigma_v.description == "σ_v (cm)"
+    assert (sigma_v.min, sigma_v.max) == bias_explorer.SIGMA_V_RANGE
+    assert sigma_v.min > 0
+    assert sigma_v.value == DEFAULT.sigma_v
+    for slider in (b, sigma_a, sigma_v):
+        assert slider.continuous_update is False
+
+
+@pytest.mark.parametrize(("name", "value"),
+                         [("bias", -55.0), ("sigma_a", 300.0), ("sigma_v", 4.5), ("bias", 0.0)])
+def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
+                                                        value: float) -> None:
+    previous_png = explorer.png
+    explorer.sliders[name].value = value
+    values = explorer.values
+    bias_ax, path_ax = explorer.figure.axes
+    noise = bias_model.unit_noise(DEFAULT)
+    expected = direct_filter(values["bias"], values["sigma_a"], values["sigma_v"], noise)
+    np.testing.assert_allclose(line(bias_ax, bias_explorer.BIAS_ESTIMATE_LABEL),
+                               expected.estimates[SHOWN, 2], rtol=0, atol=1e-9)
+    np.testing.assert_array_equal(line(bias_ax, bias_explorer.TRUE_BIAS_LABEL),
+                                  values["bias"])
+    band = band_edges(bias_ax, bias_explorer.BIAS_BAND_LABEL)
+    std = np.sqrt(expected.estimate_covariances[SHOWN, 2, 2])
+    index = np.rint(band[:, 0] / DEFAULT.dt).astype(int)
+    centre = expected.estimates[SHOWN, 2]
+    np.testing.assert_allclose(np.abs(band[:, 1] - centre[index]), 2 * std[index],
+                               rtol=1e-9, atol=1e-9)
+    truth = DEFAULT.truth[SHOWN, 0]
+    np.testing.assert_allclose(line(path_ax, bias_explorer.VISION_LABEL),
+                               truth + values["sigma_v"] * noise[SHOWN, 0], atol=1e-12)
+    np.testing.assert_allclose(line(path_ax, bias_explorer.ESTIMATE_LABEL),
+                               expected.estimates[SHOWN, 0], rtol=0, atol=1e-9)
+    # Dead reckoning: the uncorrected bias's b t²/2 plus the same noise-driven wander.
+    drift = line(path_ax, bias_explorer.DEAD_RECKONING_LABEL) - truth
+    unbiased = bias_model.dead_reckoning(
+        bias_model.step_accelerations(DEFAULT) + values["sigma_a"] * noise[:, 1],
+        bias_model.initial_state(DEFAULT, 0.0), DEFAULT.dt)[SHOWN, 0] - truth
+    np.testing.assert_allclose(drift - unbiased,
+                               bias_model.bias_drift(DEFAULT, values["bias"])[SHOWN],
+                               rtol=1e-9, atol=1e-9)
+    assert f"b = {values['bias']:g} cm/s²" in bias_ax.get_title()
+    assert explorer.png != previous_png
+
+
+def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
+    explorer.sliders["bias"].value = 20.0
+    explorer.sliders["sigma_v"].value = 1.5
+    truth = DEFAULT.truth[SHOWN, 0]
+    patterns, estimates = [], []
+    for sigma_v in (1.0, 3.0, 1.0):
+        explorer.sliders["sigma_v"].value = sigma_v
+        path_ax = explorer.figure.axes[1]
+        patterns.append((line(path_ax, bias_explorer.VISION_LABEL) - truth) / sigma_v)
+        estimates.append(line(path_ax, bias_explorer.ESTIMATE_LABEL))
+    np.testing.assert_allclose(patterns[0], patterns[1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(estimates[0], estimates[2])
+    # The acceleration signal's noise too: moving σ_a only rescales it.
+    noise_free = bias_model.dead_reckoning(bias_model.step_accelerations(DEFAULT) + 20.0,
+                                           bias_model.initial_state(DEFAULT, 0.0),
+                                           DEFAULT.dt)[SHOWN, 0]
+    wander = []
+    for sigma_a in (10.0, 40.0):
+        explorer.sliders["sigma_a"].value = sigma_a
+        wander.append(line(explorer.figure.axes[1], bias_explorer.DEAD_RECKONING_LABEL)
+                      - noise_free)
+    np.testing.assert_allclose(wander[1], 4 * wander[0], rtol=1e-6, atol=1e-9)
+    explorer.sliders["sigma_v"].value = DEFAULT.sigma_v
+    explorer.sliders["sigma_a"].value = bias_model.DEFAULT_SIGMA_A
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
+    figure = Figure()
+    noise = np.zeros((DEFAULT.n_steps, 2))
+    bias_explorer.draw_bias(figure, bias=30.0, sigma_a=5.0, sigma_v=2.0, noise=noise)
+    bias_ax, path_ax = figure.axes
+    truth = DEFAULT.truth[SHOWN, 0]
+    np.testing.assert_array_equal(line(path_ax, bias_explorer.VISION_LABEL), truth)
+    # Without noise, dead reckoning's error is exactly the bias's b t²/2.
+    np.testing.assert_allclose(line(path_ax, bias_explorer.DEAD_RECKONING_LABEL) - truth,
+                               bias_model.bias_drift(DEFAULT, 30.0)[SHOWN], atol=1e-3)
+    expected = direct_filter(30.0, 5.0, 2.0, noise)
+    np.testing.assert_allclose(line(bias_ax, bias_explorer.BIAS_ESTIMATE_LABEL),
+                               expected.estimates[SHOWN, 2], rtol=0, atol=1e-9)
+    # Drawing again replaces, not adds.
+    bias_explorer.draw_bias(figure, bias=-10.0, sigma_a=5.0, sigma_v=2.0, noise=noise)
+    assert len(figure.axes) == 2
+    assert len(figure.axes[1].get_lines()) == 4
+
+
+def test_the_bias_is_learned_at_the_default_values() -> None:
+    figure = Figure()
+    bias_explorer.draw_bias(figure, bias=20.0, sigma_a=20.0, sigma_v=1.5)
+    estimate = line(figure.axes[0], bias_explorer.BIAS_ESTIMATE_LABEL)
+    # Within 2 cm/s² of the true 20 cm/s² over the last second shown.
+    assert np.all(np.abs(estimate[-100:] - 20.0) < 2.0)
+
+
+@pytest.mark.parametrize(
+    ("values", "name"),
+    [({"bias": np.nan, "sigma_a": 20.0, "sigma_v": 1.5}, "bias"),
+     ({"bias": 20.0, "sigma_a": 0.0, "sigma_v": 1.5}, "sigma_a"),
+     ({"bias": 20.0, "sigma_a": 20.0, "sigma_v": -1.0}, "sigma_v")],
+)
+def test_bad_values_are_rejected_by_name(values: dict[str, float], name: str) -> None:
+    with pytest.raises(ValueError, match=name):
+        bias_explorer.draw_bias(Figure(), **values)
+
+
+def test_wrong_noise_shape_is_rejected() -> None:
+    with pytest.raises(ValueError, match="noise"):
+        bias_explorer.draw_bias(Figure(), bias=0.0, sigma_a=1.0, sigma_v=1.0,
+                                noise=np.zeros((DEFAULT.n_steps, 1)))
+
+
+def test_static_display_carries_the_picture(explorer) -> None:
+    bundle = explorer._repr_mimebundle_()
+    assert bundle["text/plain"].startswith("Interactive explorer")
+    for description in ("b (cm/s²)", "σ_a (cm/s²)", "σ_v (cm)"):
+        assert description in bundle["text/html"]
+    assert explorer.png.startswith(b"\x89PNG")

@@ -1,0 +1,205 @@
+"""The delay explorer of notebook 05 draws what the engine computes, on fixed noise."""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from lqe_helpers import experiments
+from lqe_helpers.explorers.delay import MAX_DELAY, WINDOW, draw_delay, explore_delay
+from lqe_helpers.scenario import DEFAULT
+
+SHOWN = DEFAULT.times <= WINDOW
+
+
+def _lines(figure: Figure) -> dict[str, np.ndarray]:
+    """y data of every line with a gid, by gid (x data checked separately)."""
+    found = {}
+    for ax in figure.axes:
+        for line in ax.lines:
+            if line.get_gid() is not None:
+                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
+                np.testing.assert_array_equal(line.get_xdata(), DEFAULT.times[SHOWN])
+                found[line.get_gid()] = np.asarray(line.get_ydata(), float)
+    return found
+
+
+def _independent(delay: float, noise: np.ndarray, sigma_v: float = DEFAULT.sigma_v) -> dict:
+    """What the figure must show, built from a plain filter run without the delay module."""
+    steps = round(delay / DEFAULT.dt)
+    tracking = experiments.track(DEFAULT, ("vision",), sigmas=[sigma_v], noise=noise)
+    estimates = tracking.result.estimates
+    truth = DEFAULT.truth[:, 0]
+    n = DEFAULT.n_steps
+    delayed = np.full(n, np.nan)
+    delayed[steps:] = estimates[: n - steps, 0]
+    vision = np.full(n, np.nan)
+    vision[steps:] = truth[: n - steps] + sigma_v * noise[: n - steps, 0]
+    ahead = np.linalg.matrix_power(DEFAULT.A, steps)
+    prediction = np.full(n, np.nan)
+    prediction[steps:] = (estimates[: n - steps] @ ahead.T)[:, 0]
+    skip = max(DEFAULT.burn_in_steps, steps)
+    return {
+        "steps": steps,
+        "lines": {
+            "truth": truth,
+            "vision": vision,
+            "delayed": delayed,
+            "prediction": prediction,
+            "delayed-error": delayed - truth,
+            "prediction-error": prediction - truth,
+        },
+        "mse": {
+            "delayed": np.mean((delayed[skip:] - truth[skip:]) ** 2),
+            "compensated": np.mean((prediction[skip:] - truth[skip:]) ** 2),
+            "no delay": np.mean((estimates[DEFAULT.burn_in_steps:, 0]
+                                 - truth[DEFAULT.burn_in_steps:]) ** 2),
+        },
+    }
+
+
+def _check_figure(figure: Figure, delay: float, noise: np.ndarray,
+                  sigma_v: float = DEFAULT.sigma_v) -> None:
+    expected = _independent(delay, noise, sigma_v)
+    lines = _lines(figure)
+    assert set(lines) == set(expected["lines"])
+    for gid, values in expected["lines"].items():
+        np.testing.assert_allclose(lines[gid], values[SHOWN], rtol=1e-12, atol=1e-9,
+                                   err_msg=gid)
+    steps = expected["steps"]
+    # Nothing has arrived before δ: no reading, no estimate, no prediction.
+    for gid in ("vision", "delayed", "prediction"):
+        assert np.all(np.isnan(lines[gid][:steps])), gid
+        assert np.all(np.isfinite(lines[gid][steps:])), gid
+    title = figure.get_suptitle()
+    assert f"d = {delay:.2f} s" in title
+    assert f"δ = {steps} steps" in title
+    for name, value in expected["mse"].items():
+        assert f"{name} {value:.2f} cm²" in title, (name, title)
+    # Every finite value is inside its axes' limits, however far a prediction overshoots.
+    for ax in figure.axes:
+        low, high = ax.get_ylim()
+        for line in ax.lines:
+            values = np.asarray(line.get_ydata(), float)
+            values = values[np.isfinite(values)]
+            assert np.all((values >= low) & (values <= high)), line.get_gid()
+    # The grey "nothing yet" band spans exactly [0, d] on both axes, once.
+    for ax in figure.axes:
+        spans = [p for p in ax.patches if p.get_gid() == "nothing-yet"]
+        if steps == 0:
+            assert spans == []
+        else:
+            assert len(spans) == 1
+            x = spans[0].get_x(), spans[0].get_x() + spans[0].get_width()
+            np.testing.assert_allclose(x, [0.0, steps * DEFAULT.dt])
+
+
+def test_slider_conventions():
+    explorer = explore_delay()
+    assert list(explorer.sliders) == ["delay"]
+    slider = explorer.sliders["delay"]
+    assert slider.description == "delay (s)"
+    assert slider.min == 0.0
+    assert slider.max == pytest.approx(MAX_DELAY)
+    assert slider.step == pytest.approx(DEFAULT.dt)
+    assert slider.value == pytest.approx(DEFAULT.delay)
+    assert slider.readout_format == ".2f"
+    assert slider.continuous_update is False
+    # Every position of the slider is a whole number of steps.
+    assert (slider.max / slider.step) == pytest.approx(round(slider.max / slider.step))
+
+
+def test_initial_figure_is_the_question_delay():
+    explorer = explore_delay()
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    _check_figure(explorer.figure, DEFAULT.delay, noise)
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.01, 0.25, MAX_DELAY])
+def test_slider_value_redraws_the_direct_computation(delay):
+    explorer = explore_delay()
+    before = explorer.png
+    explorer.sliders["delay"].value = delay
+    _check_figure(explorer.figure, delay, DEFAULT.unit_noise(sensors=("vision",)))
+    assert explorer.png != before
+
+
+def test_noise_stays_fixed_across_slider_moves():
+    explorer = explore_delay()
+    explorer.sliders["delay"].value = 0.05
+    first = _lines(explorer.figure)["vision"]
+    explorer.sliders["delay"].value = 0.32
+    second = _lines(explorer.figure)["vision"]
+    shift = 32 - 5
+    # The same readings, only arriving later: the pattern of the noise did not change.
+    np.testing.assert_array_equal(second[shift:], first[: first.size - shift])
+    explorer.sliders["delay"].value = 0.05
+    np.testing.assert_array_equal(_lines(explorer.figure)["vision"], first)
+
+
+def test_slider_value_between_steps_is_rounded_to_a_step():
+    explorer = explore_delay()
+    explorer.sliders["delay"].value = 0.1240000001
+    _check_figure(explorer.figure, 0.12, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_redraw_reuses_axes_and_keeps_one_band():
+    explorer = explore_delay()
+    axes = list(explorer.figure.axes)
+    for delay in (0.2, 0.0, 0.3):
+        explorer.sliders["delay"].value = delay
+    assert explorer.figure.axes == axes
+    assert len(axes) == 2
+    _check_figure(explorer.figure, 0.3, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise():
+    figure = Figure()
+    FigureCanvasAgg(figure)
+    noise = np.random.default_rng(11).standard_normal((DEFAULT.n_steps, 1))
+    draw_delay(figure, delay=0.17, noise=noise)
+    _check_figure(figure, 0.17, noise)
+    # Default noise is the scenario's fixed draw.
+    draw_delay(figure, delay=0.17)
+    _check_figure(figure, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_draw_function_clears_a_foreign_figure():
+    figure = Figure()
+    figure.subplots(1, 3)
+    draw_delay(figure, delay=0.1)
+    assert len(figure.axes) == 2
+    _check_figure(figure, 0.1, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_explorer_follows_its_scenario():
+    scenario = dataclasses.replace(DEFAULT, sigma_v=4.5, delay=0.2)
+    explorer = explore_delay(scenario)
+    assert explorer.sliders["delay"].value == pytest.approx(0.2)
+    noise = scenario.unit_noise(sensors=("vision",))
+    _check_figure(explorer.figure, 0.2, noise, sigma_v=4.5)
+
+
+def test_slider_range_stops_before_the_end_of_a_short_trial():
+    scenario = dataclasses.replace(DEFAULT, duration=0.3, burn_in=0.1, delay=0.1)
+    slider = explore_delay(scenario).sliders["delay"]
+    assert slider.max == pytest.approx(0.29)
+
+
+@pytest.mark.parametrize("delay", [-0.1, 0.105, 10.0, float("nan")])
+def test_bad_delay_raises(delay):
+    figure = Figure()
+    with pytest.raises(ValueError, match="delay"):
+        draw_delay(figure, delay=delay)
+
+
+def test_static_display_shows_the_figure_and_names_the_slider():
+    bundle = explore_delay()._repr_mimebundle_()
+    assert "delay (s)" in bundle["text/html"]
+    assert re.search(r'src="data:image/png;base64,[A-Za-z0-9+/=]{100,}"', bundle["text/html"])

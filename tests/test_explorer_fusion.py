@@ -1,0 +1,220 @@
+"""The fusion explorer of notebook 03 draws what a plain filter run computes, on fixed noise."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from lqe_helpers.explorers.fusion import FUSED, SIGMA_RANGE, draw_fusion, explore_fusion
+from lqe_helpers.filter import kalman_filter
+from lqe_helpers.scenario import DEFAULT, Scenario
+
+LINE_GIDS = {"vision readings", "proprioception readings", "truth", "vision-only", "fused",
+             "vision-only error", "fused error"}
+
+
+def _fresh_figure() -> Figure:
+    figure = Figure(figsize=(10.0, 5.0))
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _lines(figure: Figure, scenario: Scenario = DEFAULT) -> dict[str, np.ndarray]:
+    """y data of every line with a gid, by gid; every line runs over the whole trial."""
+    found = {}
+    for ax in figure.axes:
+        for line in ax.lines:
+            if line.get_gid() is not None:
+                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
+                np.testing.assert_array_equal(line.get_xdata(), scenario.times)
+                found[line.get_gid()] = np.asarray(line.get_ydata(), float)
+    return found
+
+
+def _weights(figure: Figure) -> dict[str, float]:
+    return {patch.get_gid(): patch.get_height() for ax in figure.axes for patch in ax.patches
+            if patch.get_gid() is not None and patch.get_gid().startswith("weight")}
+
+
+def _independent(sigma_v: float, sigma_p: float, noise: np.ndarray,
+                 scenario: Scenario = DEFAULT) -> dict[str, np.ndarray]:
+    """The lines the figure must show, from hand-built C, R and readings."""
+    truth = scenario.truth[:, 0]
+    readings = truth[:, None] + noise * [sigma_v, sigma_p]
+    z0, P0 = np.asarray(scenario.z0, float), scenario.p0_variance * np.eye(3)
+    alone = kalman_filter(readings[:, :1], scenario.A, np.array([[1.0, 0.0, 0.0]]), scenario.Q,
+                          np.array([[sigma_v**2]]), z0, P0).estimates[:, 0]
+    both = kalman_filter(readings, scenario.A, np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]),
+                         scenario.Q, np.diag([sigma_v**2, sigma_p**2]), z0, P0).estimates[:, 0]
+    return {
+        "vision readings": readings[:, 0],
+        "proprioception readings": readings[:, 1],
+        "truth": truth,
+        "vision-only": alone,
+        "fused": both,
+        "vision-only error": alone - truth,
+        "fused error": both - truth,
+    }
+
+
+def _check_figure(figure: Figure, sigma_v: float, sigma_p: float, noise: np.ndarray,
+                  scenario: Scenario = DEFAULT) -> None:
+    expected = _independent(sigma_v, sigma_p, noise, scenario)
+    lines = _lines(figure, scenario)
+    assert set(lines) == LINE_GIDS
+    for gid, values in expected.items():
+        np.testing.assert_allclose(lines[gid], values, rtol=1e-9, atol=1e-9, err_msg=gid)
+    # Reliability weighting: the shares of the position gain are (1/σ_v², 1/σ_p²) normalised.
+    share_v = sigma_p**2 / (sigma_v**2 + sigma_p**2)
+    weights = _weights(figure)
+    assert weights["weight vision"] == pytest.approx(share_v, rel=1e-9)
+    assert weights["weight proprioception"] == pytest.approx(1 - share_v, rel=1e-9)
+    texts = [text.get_text() for ax in figure.axes for text in ax.texts]
+    assert texts == [f"{100 * share_v:.0f} %", f"{100 * (1 - share_v):.0f} %"]
+    # The title carries both σ's and this trial's MSEs after the burn-in.
+    skip = scenario.burn_in_steps
+    title = figure.get_suptitle()
+    assert f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm" in title
+    for name, gid in (("vision only", "vision-only error"), ("fused", "fused error")):
+        mse = np.mean(expected[gid][skip:] ** 2)
+        assert f"{name} {mse:.3f} cm²" in title, (name, title)
+
+
+def test_slider_conventions():
+    explorer = explore_fusion()
+    assert list(explorer.sliders) == ["sigma_v", "sigma_p"]
+    low, high, step = SIGMA_RANGE
+    for name, description in (("sigma_v", "σ_v (cm)"), ("sigma_p", "σ_p (cm)")):
+        slider = explorer.sliders[name]
+        assert slider.description == description
+        assert (slider.min, slider.max, slider.step) == pytest.approx((low, high, step))
+        assert slider.min > 0  # every position is a valid σ
+        assert slider.continuous_update is False
+        assert slider.readout_format == ".2f"
+    # The question's values: both sliders start at 1.5 cm, and 4.5 cm is on the grid.
+    assert explorer.values == pytest.approx({"sigma_v": 1.5, "sigma_p": 1.5})
+    for value in (1.5, 4.5):
+        assert (value - low) / step == pytest.approx(round((value - low) / step))
+
+
+def test_initial_figure_is_question_c():
+    explorer = explore_fusion()
+    _check_figure(explorer.figure, 1.5, 1.5, DEFAULT.unit_noise(sensors=FUSED))
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize(("sigma_v", "sigma_p"), [(1.5, 4.5), (4.5, 1.5), (0.5, 6.0), (3.0, 3.0)])
+def test_slider_values_redraw_the_direct_computation(sigma_v, sigma_p):
+    explorer = explore_fusion()
+    before = explorer.png
+    explorer.sliders["sigma_v"].value = sigma_v
+    explorer.sliders["sigma_p"].value = sigma_p
+    _check_figure(explorer.figure, sigma_v, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
+    assert explorer.png != before
+
+
+def test_noise_stays_fixed_across_slider_moves():
+    explorer = explore_fusion()
+    truth = DEFAULT.truth[:, 0]
+    expected = DEFAULT.unit_noise(sensors=FUSED)
+    for sigma_v, sigma_p in ((2.0, 1.5), (2.0, 5.0), (0.75, 5.0)):
+        explorer.sliders["sigma_v"].value = sigma_v
+        explorer.sliders["sigma_p"].value = sigma_p
+        lines = _lines(explorer.figure)
+        np.testing.assert_allclose((lines["vision readings"] - truth) / sigma_v, expected[:, 0],
+                                   rtol=1e-9, atol=1e-9)
+        np.testing.assert_allclose((lines["proprioception readings"] - truth) / sigma_p,
+                                   expected[:, 1], rtol=1e-9, atol=1e-9)
+
+
+def test_moving_sigma_p_leaves_the_vision_only_filter_alone():
+    explorer = explore_fusion()
+    first = _lines(explorer.figure)
+    explorer.sliders["sigma_p"].value = 5.0
+    second = _lines(explorer.figure)
+    np.testing.assert_array_equal(second["vision-only"], first["vision-only"])
+    np.testing.assert_array_equal(second["vision readings"], first["vision readings"])
+    assert not np.allclose(second["fused"], first["fused"])
+
+
+def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
+    explorer = explore_fusion()
+    axes = list(explorer.figure.axes)
+    for sigma_v in (3.0, 0.5, 2.25):
+        explorer.sliders["sigma_v"].value = sigma_v
+    assert explorer.figure.axes == axes
+    assert len(axes) == 3
+    bands = [c for c in axes[1].collections if c.get_gid() == "fused band"]
+    assert len(bands) == 1
+    fresh = _fresh_figure()
+    draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5)
+    reused, drawn = _lines(explorer.figure), _lines(fresh)
+    for gid in LINE_GIDS:
+        np.testing.assert_array_equal(reused[gid], drawn[gid], err_msg=gid)
+    assert _weights(explorer.figure) == _weights(fresh)
+    assert explorer.figure.get_suptitle() == fresh.get_suptitle()
+
+
+def test_band_is_the_fused_filters_own_two_standard_deviations():
+    figure = _fresh_figure()
+    draw_fusion(figure, sigma_v=1.5, sigma_p=3.0)
+    (band,) = [c for c in figure.axes[1].collections if c.get_gid() == "fused band"]
+    vertices = band.get_paths()[0].vertices
+    variances = kalman_filter(
+        DEFAULT.truth[:, :1] + DEFAULT.unit_noise(sensors=FUSED) * [1.5, 3.0], DEFAULT.A,
+        np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]), DEFAULT.Q, np.diag([1.5**2, 3.0**2]),
+        np.zeros(3), np.eye(3),
+    ).estimate_covariances[:, 0, 0]
+    # The band is centred on zero error and reaches ±2 SD of the filter's own variance.
+    upper = _upper_edge(vertices)
+    np.testing.assert_allclose(upper, 2 * np.sqrt(variances), rtol=1e-9)
+    # Two sensors, σ_v = 1.5 and σ_p = 3 cm: the settled variance is below the
+    # combined reading's 1 / (1/1.5² + 1/3²) = 1.8 cm² (the filter also averages in time).
+    assert variances[-1] < 1 / (1 / 1.5**2 + 1 / 3.0**2)
+
+
+def _upper_edge(vertices: np.ndarray) -> np.ndarray:
+    """Upper edge of a fill_between polygon at each sample time (the largest y there)."""
+    return np.array([vertices[np.isclose(vertices[:, 0], t), 1].max() for t in DEFAULT.times])
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise():
+    figure = _fresh_figure()
+    noise = np.random.default_rng(7).standard_normal((DEFAULT.n_steps, 2))
+    draw_fusion(figure, sigma_v=2.5, sigma_p=1.0, noise=noise)
+    _check_figure(figure, 2.5, 1.0, noise)
+    draw_fusion(figure, sigma_v=2.5, sigma_p=1.0)
+    _check_figure(figure, 2.5, 1.0, DEFAULT.unit_noise(sensors=FUSED))
+
+
+def test_draw_function_clears_a_foreign_figure():
+    figure = _fresh_figure()
+    figure.subplots(2, 2)
+    draw_fusion(figure, sigma_v=1.5, sigma_p=4.5)
+    assert len(figure.axes) == 3
+    _check_figure(figure, 1.5, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+
+
+def test_explorer_follows_its_scenario():
+    scenario = dataclasses.replace(DEFAULT, sigma_v=2.0, sigma_p=3.0, seed=11)
+    explorer = explore_fusion(scenario)
+    assert explorer.values == pytest.approx({"sigma_v": 2.0, "sigma_p": 3.0})
+    _check_figure(explorer.figure, 2.0, 3.0, scenario.unit_noise(sensors=FUSED), scenario)
+
+
+@pytest.mark.parametrize(("sigma_v", "sigma_p", "name"),
+                         [(0.0, 1.5, "sigma_v"), (-1.0, 1.5, "sigma_v"),
+                          (1.5, float("nan"), "sigma_p"), (1.5, 0.0, "sigma_p")])
+def test_bad_sigma_raises(sigma_v, sigma_p, name):
+    with pytest.raises(ValueError, match=name):
+        draw_fusion(_fresh_figure(), sigma_v=sigma_v, sigma_p=sigma_p)
+
+
+def test_bad_noise_raises():
+    with pytest.raises(ValueError, match="noise must have shape"):
+        draw_fusion(_fresh_figure(), sigma_v=1.5, sigma_p=1.5,
+                    noise=np.zeros((DEFAULT.n_steps, 1)))

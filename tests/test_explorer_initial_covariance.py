@@ -1,0 +1,173 @@
+"""The P0 explorer of question (b) draws exactly what the engine computes."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from lqe_helpers import experiments, metrics
+from lqe_helpers.explorers import initial_covariance as ic
+from lqe_helpers.scenario import DEFAULT
+
+SHOWN = round(ic.WINDOW / DEFAULT.dt) + 1
+
+
+def line(ax: Axes, label: str) -> np.ndarray:
+    """y data of the one line labelled ``label``."""
+    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
+    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
+    return np.asarray(found[0].get_ydata(), float)
+
+
+def band_matches(ax: Axes, low: np.ndarray, high: np.ndarray) -> None:
+    """The filled band of ``ax`` has its edges at ``low`` and ``high``."""
+    found = [c for c in ax.collections if c.get_label() == ic.BAND_LABEL]
+    assert len(found) == 1
+    vertices = np.concatenate([path.vertices for path in found[0].get_paths()])
+    index = np.rint(vertices[:, 0] / DEFAULT.dt).astype(int)
+    scale = max(1.0, float(np.max(np.abs(high))))
+    on_edge = (np.isclose(vertices[:, 1], low[index], rtol=0, atol=1e-9 * scale)
+               | np.isclose(vertices[:, 1], high[index], rtol=0, atol=1e-9 * scale))
+    assert on_edge.all()
+    assert np.unique(index).size == low.size
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return ic.explore_initial_covariance()
+
+
+def test_slider_is_logarithmic_over_the_documented_range(explorer) -> None:
+    slider = explorer.sliders["p0_variance"]
+    assert slider.description == "P0 (cm²)"
+    assert slider.base == 10
+    assert (10.0**slider.min, 10.0**slider.max) == pytest.approx(ic.P0_RANGE)
+    assert slider.step == pytest.approx(1 / ic.P0_STEPS_PER_DECADE)
+    assert slider.value == DEFAULT.p0_variance
+    assert slider.continuous_update is False
+    # The question's two values are reachable slider positions.
+    for value in (1.0, 1e5):
+        position = (np.log10(value) - slider.min) / slider.step
+        assert position == pytest.approx(round(position))
+
+
+@pytest.mark.parametrize("p0_variance", [1e-2, 1e5, 1e6, 1.0])
+def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance) -> None:
+    explorer.sliders["p0_variance"].value = p0_variance
+    position_ax, velocity_ax = explorer.figure.axes
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    truth = DEFAULT.truth
+    expected = experiments.track(DEFAULT, p0_variance=p0_variance, noise=noise)
+    estimates = expected.result.estimates[:SHOWN]
+    variances = expected.result.estimate_covariances[:SHOWN]
+
+    np.testing.assert_allclose(line(position_ax, ic.VISION_LABEL),
+                               truth[:SHOWN, 0] + DEFAULT.sigma_v * noise[:SHOWN, 0],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(line(position_ax, ic.TRUTH_LABEL), truth[:SHOWN, 0])
+    np.testing.assert_allclose(line(velocity_ax, ic.TRUTH_LABEL), truth[:SHOWN, 1])
+    for ax, column in ((position_ax, 0), (velocity_ax, 1)):
+        np.testing.assert_allclose(line(ax, ic.ESTIMATE_LABEL), estimates[:, column],
+                                   rtol=1e-12, atol=1e-9)
+        std = np.sqrt(variances[:, column, column])
+        band_matches(ax, estimates[:, column] - 2 * std, estimates[:, column] + 2 * std)
+
+    title = explorer.figure.get_suptitle()
+    burn = DEFAULT.burn_in_steps
+    early = metrics.mse(expected.positions[:burn], truth[:burn, 0])
+    assert f"P0 = {p0_variance:.3g}" in title
+    assert f"{early:.2f} cm² in the first" in title
+    assert f"{float(expected.mse()):.2f} cm² after" in title
+
+
+def test_first_step_follows_tutorial_gain_formula(explorer) -> None:
+    """K = P0 Cᵀ (C P0 Cᵀ + R)⁻¹ at the first sample, by hand, for P0 = p · I."""
+    for p0_variance in (1.0, 1e5):
+        explorer.sliders["p0_variance"].value = p0_variance
+        position_ax, velocity_ax = explorer.figure.axes
+        y0 = line(position_ax, ic.VISION_LABEL)[0]
+        gain = p0_variance / (p0_variance + DEFAULT.sigma_v**2)
+        # z0 = 0, so the prediction A·z0 = 0 and the first estimate is K·y0.
+        assert line(position_ax, ic.ESTIMATE_LABEL)[0] == pytest.approx(gain * y0)
+        # A diagonal P0 gives velocity no gain at the first sample.
+        assert line(velocity_ax, ic.ESTIMATE_LABEL)[0] == pytest.approx(0.0, abs=1e-12)
+    explorer.sliders["p0_variance"].value = DEFAULT.p0_variance
+
+
+def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
+    seen = []
+    for p0_variance in (1e-2, 1e6, 1e-2):
+        explorer.sliders["p0_variance"].value = p0_variance
+        seen.append(line(explorer.figure.axes[0], ic.VISION_LABEL))
+    np.testing.assert_array_equal(seen[0], seen[1])
+    np.testing.assert_array_equal(seen[0], seen[2])
+    explorer.sliders["p0_variance"].value = DEFAULT.p0_variance
+
+
+def test_steady_state_part_does_not_depend_on_p0() -> None:
+    """Different P0 give (nearly) the same estimates once the start-up is over."""
+    figure = Figure()
+    late = []
+    for p0_variance in (1e-2, 1e6):
+        ic.draw_initial_covariance(figure, p0_variance=p0_variance)
+        late.append(line(figure.axes[0], ic.ESTIMATE_LABEL)[-20:])
+    np.testing.assert_allclose(late[0], late[1], atol=0.05)
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
+    figure = Figure()
+    noise = np.zeros((DEFAULT.n_steps, 1))
+    ic.draw_initial_covariance(figure, p0_variance=1e5, noise=noise)
+    position_ax, velocity_ax = figure.axes
+    np.testing.assert_array_equal(line(position_ax, ic.VISION_LABEL), DEFAULT.truth[:SHOWN, 0])
+    expected = experiments.track(DEFAULT, p0_variance=1e5, noise=noise)
+    np.testing.assert_allclose(line(velocity_ax, ic.ESTIMATE_LABEL),
+                               expected.result.estimates[:SHOWN, 1], rtol=1e-12, atol=1e-9)
+    assert velocity_ax.get_ylim() == pytest.approx(
+        (-2 * DEFAULT.truth[0, 1], 2 * DEFAULT.truth[0, 1]))
+    ic.draw_initial_covariance(figure, p0_variance=1.0, noise=noise)
+    assert len(figure.axes) == 2
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.0, np.nan, np.inf])
+def test_bad_p0_variance_is_rejected_by_name(bad: float) -> None:
+    with pytest.raises(ValueError, match="p0_variance"):
+        ic.draw_initial_covariance(Figure(), p0_variance=bad)
+
+
+def test_static_display_carries_the_picture(explorer) -> None:
+    bundle = explorer._repr_mimebundle_()
+    assert "P0 (cm²)" in bundle["text/html"]
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+def png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
+    reused = Figure(figsize=(9, 4))
+    for p0_variance in (1e6, 1e-2, 31.6):
+        ic.draw_initial_covariance(reused, p0_variance=p0_variance)
+        fresh = Figure(figsize=(9, 4))
+        ic.draw_initial_covariance(fresh, p0_variance=p0_variance)
+        assert png(reused) == png(fresh)
+    assert len(reused.axes) == 2
+
+
+def test_foreign_or_cleared_figure_is_rebuilt() -> None:
+    figure = Figure()
+    figure.add_subplot().plot([0, 1], [5, 6], label="someone else's line")
+    ic.draw_initial_covariance(figure, p0_variance=1.0)
+    assert len(figure.axes) == 2
+    assert "someone else's line" not in [a.get_label() for a in figure.axes[0].get_lines()]
+    figure.clear()
+    ic.draw_initial_covariance(figure, p0_variance=1e3)
+    assert len(figure.axes) == 2
+    assert figure.get_suptitle().startswith("P0 = 1e+03")

@@ -1,0 +1,212 @@
+"""The σ_p explorer of notebook 04 draws what a plain filter run and the theory compute."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from lqe_helpers.explorers.noisier_proprioception import (
+    CURVE_RANGE,
+    FUSED,
+    QUESTION_SIGMA_P,
+    SIGMA_P_RANGE,
+    draw_noisier_proprioception,
+    explore_noisier_proprioception,
+    steady_position_variances,
+)
+from lqe_helpers.filter import kalman_filter
+from lqe_helpers.scenario import DEFAULT, Scenario
+from lqe_helpers.steady_state import steady_state
+
+TRIAL_GIDS = {"truth", "vision-only", "fused", "vision-only error", "fused error"}
+ONE_ROW = np.array([[1.0, 0.0, 0.0]])
+TWO_ROWS = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+
+
+def _fresh_figure() -> Figure:
+    figure = Figure(figsize=(10.0, 5.0))
+    FigureCanvasAgg(figure)
+    return figure
+
+
+def _lines(figure: Figure) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """(x, y) of every line with a gid, by gid."""
+    found = {}
+    for ax in figure.axes:
+        for line in ax.lines:
+            if line.get_gid() is not None:
+                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
+                found[line.get_gid()] = (np.asarray(line.get_xdata(), float),
+                                         np.asarray(line.get_ydata(), float))
+    return found
+
+
+def _filter(readings: np.ndarray, sigmas: list[float], scenario: Scenario):
+    C = TWO_ROWS if len(sigmas) == 2 else ONE_ROW
+    return kalman_filter(readings, scenario.A, C, scenario.Q, np.diag(np.square(sigmas)),
+                         np.asarray(scenario.z0, float), scenario.p0_variance * np.eye(3))
+
+
+def _check_figure(figure: Figure, sigma_p: float, noise: np.ndarray,
+                  scenario: Scenario = DEFAULT) -> None:
+    sigma_v = scenario.sigma_v
+    truth = scenario.truth[:, 0]
+    readings = truth[:, None] + noise * [sigma_v, sigma_p]
+    alone = _filter(readings[:, :1], [sigma_v], scenario).estimates[:, 0]
+    fused = _filter(readings, [sigma_v, sigma_p], scenario)
+    both = fused.estimates[:, 0]
+    expected = {"truth": truth, "vision-only": alone, "fused": both,
+                "vision-only error": alone - truth, "fused error": both - truth}
+    lines = _lines(figure)
+    assert TRIAL_GIDS <= set(lines)
+    for gid, values in expected.items():
+        np.testing.assert_array_equal(lines[gid][0], scenario.times)
+        np.testing.assert_allclose(lines[gid][1], values, rtol=1e-9, atol=1e-9, err_msg=gid)
+    # The marker sits on the theory curve at the slider's σ_p: the filter's own
+    # converged position variance (an independent route to the Riccati fixed point).
+    x, y = lines["theory now"]
+    assert x == pytest.approx([sigma_p])
+    assert y == pytest.approx([fused.estimate_covariances[-1, 0, 0]], rel=1e-7)
+    # Proprioception's weight is its share of the reliabilities 1/σ².
+    weight = sigma_v**2 / (sigma_v**2 + sigma_p**2)
+    theory_ax = figure.axes[2]
+    assert f"proprioception's weight: {100 * weight:.0f} %" in theory_ax.get_title()
+    skip = scenario.burn_in_steps
+    title = figure.get_suptitle()
+    assert f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm" in title
+    for name, estimate in (("vision only", alone), ("fused", both)):
+        mse = np.mean((estimate[skip:] - truth[skip:]) ** 2)
+        assert f"{name} {mse:.3f} cm²" in title, (name, title)
+
+
+def test_slider_conventions():
+    explorer = explore_noisier_proprioception()
+    assert list(explorer.sliders) == ["sigma_p"]
+    slider = explorer.sliders["sigma_p"]
+    low, high, step = SIGMA_P_RANGE
+    assert slider.description == "σ_p (cm)"
+    assert (slider.min, slider.max, slider.step) == pytest.approx((low, high, step))
+    assert slider.min > 0
+    assert slider.continuous_update is False
+    assert slider.readout_format == ".1f"
+    assert QUESTION_SIGMA_P == 4.5
+    assert slider.value == pytest.approx(QUESTION_SIGMA_P)
+    for value in (1.5, 4.5):
+        assert (value - low) / step == pytest.approx(round((value - low) / step))
+
+
+def test_initial_figure_is_question_d():
+    explorer = explore_noisier_proprioception()
+    _check_figure(explorer.figure, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize("sigma_p", [0.5, 1.5, 9.0, 30.0])
+def test_slider_value_redraws_the_direct_computation(sigma_p):
+    explorer = explore_noisier_proprioception()
+    before = explorer.png
+    explorer.sliders["sigma_p"].value = sigma_p
+    _check_figure(explorer.figure, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
+    assert explorer.png != before
+
+
+def test_noise_stays_fixed_across_slider_moves():
+    explorer = explore_noisier_proprioception()
+    first = _lines(explorer.figure)
+    for sigma_p in (12.0, 0.5, 4.5):
+        explorer.sliders["sigma_p"].value = sigma_p
+        lines = _lines(explorer.figure)
+        # Vision and its filter do not depend on σ_p at all.
+        np.testing.assert_array_equal(lines["vision-only"][1], first["vision-only"][1])
+    # Back at 4.5 cm the same noise gives the same fused estimate, bit for bit.
+    np.testing.assert_array_equal(lines["fused"][1], first["fused"][1])
+
+
+def test_theory_curve_matches_separate_riccati_solves():
+    figure = _fresh_figure()
+    draw_noisier_proprioception(figure, sigma_p=4.5)
+    lines = _lines(figure)
+    x, y = lines["theory fused"]
+    np.testing.assert_allclose(x[[0, -1]], CURVE_RANGE)
+    assert np.all(np.diff(np.log(x)) > 0)
+    for i in (0, 40, 85, x.size - 1):
+        one = steady_state(DEFAULT.A, TWO_ROWS, DEFAULT.Q, np.diag([1.5**2, x[i] ** 2]))
+        assert y[i] == pytest.approx(one.estimate_covariance[0, 0], rel=1e-9)
+    alone = steady_state(DEFAULT.A, ONE_ROW, DEFAULT.Q, np.array([[1.5**2]]))
+    level = alone.estimate_covariance[0, 0]
+    _, level_y = lines["theory vision-only"]
+    np.testing.assert_allclose(level_y, level, rtol=1e-12)
+    # An extra, correctly modelled sensor never hurts, and helps less as it gets noisier.
+    assert np.all(y < level)
+    assert np.all(np.diff(y) > 0)
+    assert y[-1] == pytest.approx(level, rel=1e-3)
+
+
+def test_steady_position_variances_against_the_filter_run_to_convergence():
+    sigma_p = np.array([0.8, 4.5, 20.0])
+    level, fused = steady_position_variances(DEFAULT, 1.5, sigma_p)
+    long_run = dataclasses.replace(DEFAULT, duration=30.0)
+    y = np.zeros((long_run.n_steps, 2))
+    for s, value in enumerate(sigma_p):
+        run = _filter(y, [1.5, value], long_run)
+        assert fused[s] == pytest.approx(run.estimate_covariances[-1, 0, 0], rel=1e-7)
+    run = _filter(y[:, :1], [1.5], long_run)
+    assert level == pytest.approx(run.estimate_covariances[-1, 0, 0], rel=1e-7)
+
+
+def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
+    explorer = explore_noisier_proprioception()
+    axes = list(explorer.figure.axes)
+    for sigma_p in (2.0, 25.0, 7.5):
+        explorer.sliders["sigma_p"].value = sigma_p
+    assert explorer.figure.axes == axes
+    assert len(axes) == 3
+    fresh = _fresh_figure()
+    draw_noisier_proprioception(fresh, sigma_p=7.5)
+    reused, drawn = _lines(explorer.figure), _lines(fresh)
+    assert set(reused) == set(drawn)
+    for gid in drawn:
+        for a, b in zip(reused[gid], drawn[gid], strict=True):
+            np.testing.assert_array_equal(a, b, err_msg=gid)
+    assert explorer.figure.get_suptitle() == fresh.get_suptitle()
+    assert axes[2].get_title() == fresh.axes[2].get_title()
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise():
+    figure = _fresh_figure()
+    noise = np.random.default_rng(3).standard_normal((DEFAULT.n_steps, 2))
+    draw_noisier_proprioception(figure, sigma_p=2.5, noise=noise)
+    _check_figure(figure, 2.5, noise)
+
+
+def test_draw_function_clears_a_foreign_figure():
+    figure = _fresh_figure()
+    figure.subplots(1, 4)
+    draw_noisier_proprioception(figure, sigma_p=4.5)
+    assert len(figure.axes) == 3
+    _check_figure(figure, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+
+
+def test_explorer_follows_its_scenario():
+    scenario = dataclasses.replace(DEFAULT, sigma_v=3.0, seed=2)
+    explorer = explore_noisier_proprioception(scenario)
+    _check_figure(explorer.figure, 4.5, scenario.unit_noise(sensors=FUSED), scenario)
+
+
+@pytest.mark.parametrize("sigma_p", [0.0, -4.5, float("inf")])
+def test_bad_sigma_p_raises(sigma_p):
+    with pytest.raises(ValueError, match="sigma_p"):
+        draw_noisier_proprioception(_fresh_figure(), sigma_p=sigma_p)
+
+
+def test_bad_inputs_to_the_theory_raise():
+    with pytest.raises(ValueError, match="sigma_p"):
+        steady_position_variances(DEFAULT, 1.5, np.array([1.0, -2.0]))
+    with pytest.raises(ValueError, match="sigma_v"):
+        steady_position_variances(DEFAULT, 0.0, np.array([1.0]))
+    with pytest.raises(ValueError, match="noise must have shape"):
+        draw_noisier_proprioception(_fresh_figure(), sigma_p=4.5, noise=np.zeros((3, 2)))

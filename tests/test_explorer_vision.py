@@ -1,0 +1,164 @@
+"""The σ_v explorer of question (a) draws exactly what the engine computes."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from lqe_helpers import experiments, metrics
+from lqe_helpers.explorers import vision
+from lqe_helpers.scenario import DEFAULT
+
+
+def line(ax: Axes, label: str) -> np.ndarray:
+    """y data of the one line labelled ``label``."""
+    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
+    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
+    return np.asarray(found[0].get_ydata(), float)
+
+
+def band_matches(ax: Axes, label: str, low: np.ndarray, high: np.ndarray) -> None:
+    """The filled band labelled ``label`` has its edges at ``low`` and ``high``."""
+    found = [c for c in ax.collections if c.get_label() == label]
+    assert len(found) == 1, f"expected one band labelled {label!r}, got {len(found)}"
+    vertices = np.concatenate([path.vertices for path in found[0].get_paths()])
+    index = np.rint(vertices[:, 0] / DEFAULT.dt).astype(int)
+    on_edge = (np.isclose(vertices[:, 1], low[index], rtol=0, atol=1e-9)
+               | np.isclose(vertices[:, 1], high[index], rtol=0, atol=1e-9))
+    assert on_edge.all()
+    # Both edges are traced over every sample.
+    assert np.unique(index).size == low.size
+
+
+@pytest.fixture(scope="module")
+def explorer():
+    return vision.explore_vision()
+
+
+def test_slider_follows_the_conventions(explorer) -> None:
+    slider = explorer.sliders["sigma_v"]
+    assert slider.description == "σ_v (cm)"
+    assert (slider.min, slider.max) == vision.SIGMA_V_RANGE
+    assert slider.min > 0
+    assert slider.value == DEFAULT.sigma_v
+    assert slider.continuous_update is False
+    assert slider.readout_format == ".1f"
+
+
+@pytest.mark.parametrize("sigma_v", [0.1, 4.5, 10.0, 1.5])
+def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: float) -> None:
+    previous_png = explorer.png
+    explorer.sliders["sigma_v"].value = sigma_v
+    (ax,) = explorer.figure.axes
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    truth = DEFAULT.truth[:, 0]
+    # Measurements straight from Tutorial eq. (3): truth plus σ_v times the fixed noise.
+    np.testing.assert_allclose(line(ax, vision.VISION_LABEL), truth + sigma_v * noise[:, 0],
+                               rtol=0, atol=1e-12)
+    np.testing.assert_allclose(line(ax, vision.TRUTH_LABEL), truth)
+    expected = experiments.track(DEFAULT, sigmas=[sigma_v], noise=noise)
+    np.testing.assert_allclose(line(ax, vision.ESTIMATE_LABEL), expected.positions,
+                               rtol=0, atol=1e-12)
+    std = np.sqrt(expected.position_variances)
+    band_matches(ax, vision.BAND_LABEL, expected.positions - 2 * std,
+                 expected.positions + 2 * std)
+    title = ax.get_title()
+    assert f"σ_v = {sigma_v:.1f} cm" in title
+    raw = metrics.mse(truth + sigma_v * noise[:, 0], truth, DEFAULT.burn_in_steps)
+    assert f"raw vision {raw:.2f} cm²" in title
+    assert f"filtered {float(expected.mse()):.2f} cm²" in title
+    if sigma_v != DEFAULT.sigma_v:
+        assert explorer.png != previous_png
+
+
+def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
+    truth = DEFAULT.truth[:, 0]
+    patterns = []
+    for sigma_v in (0.5, 7.3, 0.5):
+        explorer.sliders["sigma_v"].value = sigma_v
+        (ax,) = explorer.figure.axes
+        patterns.append((line(ax, vision.VISION_LABEL) - truth) / sigma_v)
+    np.testing.assert_allclose(patterns[0], patterns[1], rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(patterns[0], patterns[2])
+    explorer.sliders["sigma_v"].value = DEFAULT.sigma_v
+
+
+def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
+    figure = Figure()
+    noise = np.zeros((DEFAULT.n_steps, 1))
+    vision.draw_vision(figure, sigma_v=2.0, noise=noise)
+    (ax,) = figure.axes
+    truth = DEFAULT.truth[:, 0]
+    # Zero noise: vision sees the truth, and the filter's only error is its lag.
+    np.testing.assert_array_equal(line(ax, vision.VISION_LABEL), truth)
+    expected = experiments.track(DEFAULT, sigmas=[2.0], noise=noise)
+    np.testing.assert_allclose(line(ax, vision.ESTIMATE_LABEL), expected.positions,
+                               rtol=0, atol=1e-12)
+    assert "raw vision 0.00 cm²" in ax.get_title()
+    # Drawing again replaces, not adds.
+    vision.draw_vision(figure, sigma_v=3.0, noise=noise)
+    assert len(figure.axes) == 1
+    assert len(figure.axes[0].get_lines()) == 3
+
+
+def test_filter_beats_raw_vision_at_the_question_values() -> None:
+    figure = Figure()
+    for sigma_v in (1.5, 4.5):
+        vision.draw_vision(figure, sigma_v=sigma_v)
+        (ax,) = figure.axes
+        truth = DEFAULT.truth[:, 0]
+        skip = DEFAULT.burn_in_steps
+        raw = np.mean((line(ax, vision.VISION_LABEL) - truth)[skip:] ** 2)
+        filtered = np.mean((line(ax, vision.ESTIMATE_LABEL) - truth)[skip:] ** 2)
+        assert filtered < raw / 3
+
+
+@pytest.mark.parametrize("bad", [0.0, -1.5, np.nan, np.inf])
+def test_bad_sigma_v_is_rejected_by_name(bad: float) -> None:
+    with pytest.raises(ValueError, match="sigma_v"):
+        vision.draw_vision(Figure(), sigma_v=bad)
+
+
+def test_wrong_noise_shape_is_rejected() -> None:
+    with pytest.raises(ValueError, match="noise"):
+        vision.draw_vision(Figure(), sigma_v=1.5, noise=np.zeros((10, 1)))
+
+
+def test_static_display_carries_the_picture(explorer) -> None:
+    bundle = explorer._repr_mimebundle_()
+    assert bundle["text/plain"].startswith("Interactive explorer")
+    assert "σ_v (cm)" in bundle["text/html"]
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+def png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
+    reused = Figure(figsize=(9, 4))
+    for sigma_v in (0.3, 9.0, 2.5):
+        vision.draw_vision(reused, sigma_v=sigma_v)
+        fresh = Figure(figsize=(9, 4))
+        vision.draw_vision(fresh, sigma_v=sigma_v)
+        assert png(reused) == png(fresh)
+    assert len(reused.axes) == 1
+
+
+def test_foreign_or_cleared_figure_is_rebuilt() -> None:
+    figure = Figure()
+    figure.add_subplot().plot([0, 1], [5, 6], label="someone else's line")
+    vision.draw_vision(figure, sigma_v=1.5)
+    (ax,) = figure.axes
+    assert "someone else's line" not in [artist.get_label() for artist in ax.get_lines()]
+    figure.clear()
+    vision.draw_vision(figure, sigma_v=2.0)
+    (ax,) = figure.axes
+    assert "σ_v = 2.0 cm" in ax.get_title()
+    assert len(ax.get_lines()) == 3
