@@ -12,7 +12,7 @@ CONSTRAINT_FLAG := $(if $(CONSTRAINTS),-c $(CONSTRAINTS),)
 STAMP := $(VENV)/.installed
 PYTEST_ARGS ?=
 
-.PHONY: lab test lint notebooks handouts student clean
+.PHONY: lab test lint notebooks handouts student bench clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -28,7 +28,8 @@ lab: $(STAMP)
 lint: $(STAMP)
 	$(BIN)/ruff check lqe_helpers tests benchmarks notebooks
 
-# Every test: ruff, the unit tests and nbval over every notebook.
+# Every test: ruff, the unit tests, nbval over every notebook and the browser tests
+# (skipped with a reason where no Chromium is installed).
 test: $(STAMP) lint
 	$(BIN)/python -m pytest tests --nbval notebooks --nbval-current-env $(PYTEST_ARGS)
 
@@ -43,6 +44,12 @@ handouts: $(STAMP)
 # Student edition in build/student/: solutions replaced by stubs, answers by prompts.
 student: $(STAMP)
 	$(BIN)/python -m lqe_helpers.student_edition --source notebooks --out build/student
+
+# Speed against a peer in the same process (ratios, not pass/fail): filter and sliders.
+bench: $(STAMP)
+	$(BIN)/python benchmarks/bench_filter.py
+	$(BIN)/python benchmarks/bench_widgets.py
+	$(BIN)/python benchmarks/bench_notebooks.py
 
 clean:
 	rm -rf $(VENV) build .pytest_cache .ruff_cache .hypothesis lqe_course_pack.egg-info

@@ -9,8 +9,10 @@
     build/handouts/prose/NN_name.html  prose, printed results and figures only
 
 Each notebook is executed once, in a fresh kernel, by
-:func:`lqe_helpers.notebook_runner.execute_notebook`; a notebook that raises stops the
-build. Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
+:func:`lqe_helpers.notebook_runner.execute_notebook`. A notebook that raises, shows an
+error output, or displays a widget with no static view (which a page could only show
+as a placeholder) stops the build; output on stderr (a warning) is reported but
+kept. Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
 
 - every figure embedded as a base64 ``data:`` URI (outputs and markdown images);
 - the widget-view mimetype left out of the display priority, so an explorer shows
@@ -20,14 +22,18 @@ build. Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
   and loads ``async``: offline, the equations stay readable as their LaTeX source
   and nothing waits for the network;
 - nbconvert's ``TagRemovePreprocessor`` honouring the usual ``remove-cell``,
-  ``remove-input`` and ``remove-output`` tags, should an author want a cell hidden.
+  ``remove-input`` and ``remove-output`` tags, should an author want a cell hidden;
+- markdown links to another notebook of the pack (``03_fusion.ipynb#...``) pointed
+  at its page (``03_fusion.html#...``).
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import re
 import sys
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -36,9 +42,11 @@ import nbformat
 from jinja2 import DictLoader
 from nbclient.exceptions import CellExecutionError
 from nbconvert.exporters import HTMLExporter
+from nbconvert.preprocessors import Preprocessor
+from traitlets import List, Unicode
 from traitlets.config import Config
 
-from lqe_helpers.notebook_runner import execute_notebook
+from lqe_helpers.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook
 from lqe_helpers.student_edition import check_out_dir, source_notebooks
 
 #: Folder (inside the output folder) of the variant without code cells.
@@ -134,6 +142,39 @@ class HandoutBuildError(RuntimeError):
     """A notebook could not be turned into a handout (it raised, or shows an error)."""
 
 
+class HandoutWarning(UserWarning):
+    """A handout page will show something a reader should not need (a warning)."""
+
+
+class NotebookLinkPreprocessor(Preprocessor):
+    """Point markdown links to another notebook of the pack at that notebook's page.
+
+    ``[see question (c)](03_fusion.ipynb#The-question)`` becomes a link to
+    ``03_fusion.html#The-question``, in markdown and in raw ``href`` attributes. Only
+    the notebooks named in ``stems`` are rewritten; any other link is left alone.
+    """
+
+    stems = List(Unicode(), help="File stems of the notebooks that have a page.").tag(
+        config=True)
+
+    _LINK = re.compile(
+        r"""(?P<before>\]\(\s*<?|href\s*=\s*["'])(?:\./)?(?P<stem>[\w.-]+)\.ipynb"""
+        r"""(?=[#)>"'\s])"""
+    )
+
+    def preprocess_cell(self, cell: nbformat.NotebookNode, resources: dict,
+                        index: int) -> tuple[nbformat.NotebookNode, dict]:
+        """Rewrite the links of a markdown cell."""
+        if cell.cell_type == "markdown" and ".ipynb" in cell.source:
+            stems = set(self.stems)
+            cell.source = self._LINK.sub(
+                lambda match: (f"{match['before']}{match['stem']}.html"
+                               if match["stem"] in stems else match[0]),
+                cell.source,
+            )
+        return cell, resources
+
+
 @dataclass(frozen=True)
 class Page:
     """One handout page: the notebook's file stem and its title."""
@@ -169,7 +210,34 @@ def error_outputs(notebook: nbformat.NotebookNode) -> list[str]:
     return found
 
 
-def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_URL) -> HTMLExporter:
+def unshowable_widgets(notebook: nbformat.NotebookNode) -> list[str]:
+    """Where ``notebook`` displays a widget with nothing but text beside it.
+
+    An explorer's output also carries its figure (``text/html`` and ``image/png``); a
+    bare ipywidget carries only ``text/plain`` ("VBox(children=...)"), which is what
+    a page would show in place of the sliders.
+    """
+    static = set(DISPLAY_PRIORITY) - {"text/plain"}
+    return [
+        f"cell {index}: {output.get('data', {}).get('text/plain', 'a widget')!s:.60}"
+        for index, cell in enumerate(notebook.cells)
+        for output in cell.get("outputs", [])
+        if WIDGET_VIEW_MIMETYPE in output.get("data", {}) and not static & set(output["data"])
+    ]
+
+
+def stderr_outputs(notebook: nbformat.NotebookNode) -> list[str]:
+    """Where ``notebook`` printed to stderr: ``"cell N: first line"`` per stream."""
+    return [
+        f"cell {index}: {(output.get('text', '').strip().splitlines() or [''])[0]}"
+        for index, cell in enumerate(notebook.cells)
+        for output in cell.get("outputs", [])
+        if output.get("output_type") == "stream" and output.get("name") == "stderr"
+    ]
+
+
+def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_URL,
+                     stems: Sequence[str] = ()) -> HTMLExporter:
     """The HTML exporter for handout pages.
 
     Parameters
@@ -179,6 +247,9 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_UR
         printed results and figures only, without prompts).
     mathjax_url : str
         Where MathJax is loaded from (``async``); ``""`` leaves MathJax out.
+    stems : sequence of str
+        File stems of the notebooks that get a page next to this one; markdown links
+        to ``<stem>.ipynb`` are pointed at ``<stem>.html``.
     """
     config = Config()
     config.NbConvertBase.display_data_priority = list(DISPLAY_PRIORITY)
@@ -195,6 +266,7 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_UR
     exporter = HTMLExporter(config=config, template_name="lab",
                             extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
     exporter.template_file = _TEMPLATE_NAME
+    exporter.register_preprocessor(NotebookLinkPreprocessor(stems=list(stems)), enabled=True)
     return exporter
 
 
@@ -222,7 +294,10 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
 
 
 def _execute(path: Path) -> nbformat.NotebookNode:
-    """Execute ``path`` fresh; raise :class:`HandoutBuildError` if it shows an error."""
+    """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
+
+    Warns (:class:`HandoutWarning`) if a cell printed to stderr.
+    """
     try:
         notebook = execute_notebook(path)
     except CellExecutionError as error:
@@ -232,6 +307,15 @@ def _execute(path: Path) -> nbformat.NotebookNode:
     errors = error_outputs(notebook)
     if errors:
         raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}")
+    widgets = unshowable_widgets(notebook)
+    if widgets:
+        raise HandoutBuildError(
+            f"{path} displays widget(s) with no static view, which a page could only show "
+            f"as a placeholder (display an Explorer, or a figure): {'; '.join(widgets)}")
+    printed = stderr_outputs(notebook)
+    if printed:
+        warnings.warn(f"{path} prints to stderr, which its page will show: "
+                      f"{'; '.join(printed)}", HandoutWarning, stacklevel=3)
     notebook.metadata.pop("widgets", None)
     return notebook
 
@@ -272,7 +356,8 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     written = []
     for code, folder in ((True, out_dir), (False, out_dir / PROSE_DIR)):
         folder.mkdir(parents=True, exist_ok=True)
-        exporter = handout_exporter(code=code, mathjax_url=mathjax_url)
+        exporter = handout_exporter(code=code, mathjax_url=mathjax_url,
+                                    stems=[page.stem for page in pages])
         for number, ((path, notebook), page) in enumerate(zip(executed, pages, strict=True)):
             nav = {
                 "index": "index.html",

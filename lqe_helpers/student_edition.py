@@ -13,7 +13,8 @@ whole pack):
     ``raise NotImplementedError(...)``, and its tag becomes ``task``.
 ``answer``
     A markdown cell holding a written answer. In the student edition it becomes an
-    answer prompt ("**Your answer:** ...") tagged ``answer-prompt``.
+    answer prompt ("**Your answer:** ...") tagged ``answer-prompt``; headings at the
+    top of the cell are kept, the rest of its text is not.
 ``explorer``
     A code cell that displays an interactive explorer. It is self-contained and kept
     as it is, so the sliders work in the student edition too.
@@ -21,12 +22,18 @@ whole pack):
 Every output and execution count is cleared, and notebook metadata other than the
 kernel and language (widget state included) is dropped. The source notebooks are
 only read, never written.
+
+A source notebook with no ``solution`` cell stops the build: its student edition
+would hand out every worked answer as it stands. ``--allow-without-solutions``
+builds it anyway, with a warning.
 """
 
 from __future__ import annotations
 
 import argparse
+import copy
 import sys
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -72,6 +79,14 @@ STUDENT_NOTE = (
 )
 
 
+class MissingSolutionsError(ValueError):
+    """A source notebook has no ``solution`` cell, so it has nothing to take out."""
+
+
+class MissingSolutionsWarning(UserWarning):
+    """A student notebook was built from a source with no ``solution`` cell."""
+
+
 def task_instruction(source: str) -> list[str]:
     """The instruction lines at the top of a solution cell.
 
@@ -111,6 +126,34 @@ def stub_source(source: str) -> str:
     return "\n".join([*task_instruction(source), f'raise NotImplementedError("{STUB_MESSAGE}")'])
 
 
+def answer_headings(source: str) -> list[str]:
+    """The markdown headings at the top of an answer cell (kept in its prompt).
+
+    Parameters
+    ----------
+    source : str
+        The answer cell's markdown.
+
+    Returns
+    -------
+    list of str
+        The heading lines (``#`` ...) before the first line of other text; blank
+        lines between them are skipped.
+    """
+    headings = []
+    for line in source.splitlines():
+        if line.startswith("#"):
+            headings.append(line.rstrip())
+        elif line.strip():
+            break
+    return headings
+
+
+def prompt_source(source: str) -> str:
+    """The student-edition prompt for an answer cell: its headings, then the prompt."""
+    return "\n\n".join([*answer_headings(source), ANSWER_PROMPT])
+
+
 def _tags(cell: nbformat.NotebookNode) -> list[str]:
     return list(cell.get("metadata", {}).get("tags", []))
 
@@ -120,7 +163,8 @@ class StudentEditionPreprocessor(Preprocessor):
 
     Keyed on cell tags: a code cell tagged ``solution`` keeps its leading
     ``# Task:`` comment block followed by ``raise NotImplementedError(...)``; a
-    markdown cell tagged ``answer`` becomes an answer prompt. Everything else,
+    markdown cell tagged ``answer`` becomes an answer prompt (its headings kept).
+    Everything else,
     explorer cells included, passes through unchanged. A note on how to use the
     student edition is inserted after the first cell.
 
@@ -178,7 +222,7 @@ class StudentEditionPreprocessor(Preprocessor):
             if cell.cell_type != "markdown":
                 raise ValueError(f"{where}: tag {self.answer_tag!r} is for markdown cells, "
                                  f"got a {cell.cell_type} cell")
-            cell.source = ANSWER_PROMPT
+            cell.source = prompt_source(cell.source)
             cell.pop("attachments", None)
             new_tag = self.answer_prompt_tag
         old = {self.solution_tag, self.answer_tag}
@@ -225,8 +269,73 @@ def check_out_dir(source_dir: Path, out_dir: Path) -> None:
         raise ValueError(f"out_dir must differ from source_dir, got {out_dir} for both")
 
 
-def build_student_edition(source_dir: Path, out_dir: Path) -> list[Path]:
+def count_solutions(notebook: nbformat.NotebookNode) -> int:
+    """How many cells of ``notebook`` are tagged ``solution``."""
+    return sum(SOLUTION_TAG in _tags(cell) for cell in notebook.cells)
+
+
+def check_has_solutions(notebook: nbformat.NotebookNode, name: str, *,
+                        allow_without_solutions: bool = False) -> None:
+    """Refuse (or warn about) a source notebook with no ``solution`` cell.
+
+    Without one the student edition would be the source with its outputs cleared:
+    every worked answer handed out, and nothing to tell anyone so.
+
+    Parameters
+    ----------
+    notebook : nbformat.NotebookNode
+        The source notebook.
+    name : str
+        Its name, for the message.
+    allow_without_solutions : bool
+        Warn (:class:`MissingSolutionsWarning`) instead of raising.
+
+    Raises
+    ------
+    MissingSolutionsError
+        If no cell is tagged ``solution`` and ``allow_without_solutions`` is false.
+    """
+    if count_solutions(notebook):
+        return
+    message = (f"{name}: no cell is tagged {SOLUTION_TAG!r}, so its student edition would "
+               f"contain every worked answer. Tag the solution cells (see the README), or "
+               f"build with --allow-without-solutions to hand it out as it is")
+    if not allow_without_solutions:
+        raise MissingSolutionsError(message)
+    warnings.warn(message, MissingSolutionsWarning, stacklevel=3)
+
+
+def student_edition(notebook: nbformat.NotebookNode, name: str = "notebook") -> str:
+    """The student edition of one notebook, as the text of an ``.ipynb`` file.
+
+    Parameters
+    ----------
+    notebook : nbformat.NotebookNode
+        The source notebook (not modified).
+    name : str
+        Its name, used in error messages.
+
+    Returns
+    -------
+    str
+        The student notebook (nbformat 4 JSON).
+
+    Raises
+    ------
+    ValueError
+        If the notebook breaks the tag convention (the message names the cell).
+    """
+    resources = {"metadata": {"name": name}}
+    text, _ = student_exporter().from_notebook_node(copy.deepcopy(notebook), resources)
+    return text
+
+
+def build_student_edition(source_dir: Path, out_dir: Path, *,
+                          allow_without_solutions: bool = False) -> list[Path]:
     """Write the student edition of every notebook in ``source_dir`` to ``out_dir``.
+
+    Every notebook is checked before anything is written, so a refused build
+    leaves ``out_dir`` as it was.
 
     Parameters
     ----------
@@ -235,6 +344,9 @@ def build_student_edition(source_dir: Path, out_dir: Path) -> list[Path]:
     out_dir : Path
         Folder for the student notebooks (created if needed); files of the same
         name are overwritten.
+    allow_without_solutions : bool
+        Build a notebook that has no ``solution`` cell, with a warning, instead of
+        refusing the whole build.
 
     Returns
     -------
@@ -243,23 +355,24 @@ def build_student_edition(source_dir: Path, out_dir: Path) -> list[Path]:
 
     Raises
     ------
+    MissingSolutionsError
+        If a notebook has no ``solution`` cell (unless allowed).
     ValueError
         If the folders are unusable or a notebook breaks the tag convention.
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
-    notebooks = source_notebooks(source_dir)
+    paths = source_notebooks(source_dir)
     check_out_dir(source_dir, out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    exporter = student_exporter()
-    written = []
-    for path in notebooks:
+    editions = []
+    for path in paths:
         notebook = nbformat.read(path, as_version=4)
-        resources = {"metadata": {"name": path.stem, "path": str(path.parent)}}
-        text, _ = exporter.from_notebook_node(notebook, resources)
-        target = out_dir / path.name
+        check_has_solutions(notebook, path.name,
+                            allow_without_solutions=allow_without_solutions)
+        editions.append((out_dir / path.name, student_edition(notebook, path.stem)))
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for target, text in editions:
         target.write_text(text, encoding="utf-8")
-        written.append(target)
-    return written
+    return [target for target, _ in editions]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -269,11 +382,16 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="folder of the source notebooks (default: notebooks)")
     parser.add_argument("--out", type=Path, default=Path("build/student"),
                         help="folder for the student notebooks (default: build/student)")
+    parser.add_argument("--allow-without-solutions", action="store_true",
+                        help="build notebooks that have no 'solution' cell (with a warning) "
+                             "instead of refusing")
     args = parser.parse_args(argv)
     try:
-        written = build_student_edition(args.source, args.out)
+        written = build_student_edition(args.source, args.out,
+                                        allow_without_solutions=args.allow_without_solutions)
     except ValueError as error:
-        parser.error(str(error))
+        print(f"error: {error}", file=sys.stderr)
+        return 1
     for path in written:
         print(path)
     return 0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import io
 import math
 
 import numpy as np
@@ -55,6 +56,8 @@ def test_slider_follows_the_conventions(explorer) -> None:
     assert slider.base == 10
     assert slider.value == pytest.approx(DEFAULT.process_jerk_std)
     assert slider.continuous_update is False
+    # The readout must read back what it shows ("1,396" would be read as 1).
+    assert slider.readout_format == ".0f"
     assert low < DEFAULT.process_jerk_std < high
 
 
@@ -178,3 +181,47 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_j (cm/s³)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+
+
+def png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
+    reused = Figure(figsize=(10, 4.2))
+    for jerk_std in (10.0, 1.0e5, DEFAULT.process_jerk_std):
+        background.draw_background(reused, jerk_std=jerk_std)
+        fresh = Figure(figsize=(10, 4.2))
+        background.draw_background(fresh, jerk_std=jerk_std)
+        assert png(reused) == png(fresh)
+    assert len(reused.axes) == 2
+
+
+def test_foreign_or_cleared_figure_is_rebuilt() -> None:
+    figure = Figure()
+    figure.add_subplot().plot([0, 1], [5, 6], label="someone else's line")
+    background.draw_background(figure, jerk_std=500.0)
+    growth_ax, track_ax = figure.axes
+    labels = [line.get_label() for ax in figure.axes for line in ax.get_lines()]
+    assert "someone else's line" not in labels
+    figure.clear()
+    background.draw_background(figure, jerk_std=2000.0)
+    growth_ax, track_ax = figure.axes
+    assert "σ_j = 2,000 cm/s³" in growth_ax.get_title()
+    assert len(growth_ax.get_lines()) == 3
+    assert len(track_ax.get_lines()) == 3
+
+
+def test_another_scenario_redraws_its_reference_curve() -> None:
+    """The fixed artists (reference growth, true path) follow the figure's scenario."""
+    figure = Figure()
+    background.draw_background(figure, jerk_std=500.0)
+    noisier = dataclasses.replace(DEFAULT, sigma_v=4.5)
+    background.draw_background(figure, jerk_std=500.0, scenario=noisier)
+    growth_ax = figure.axes[0]
+    P = steady_state(noisier.A, model.observation_matrix(("vision",)), noisier.Q,
+                     model.measurement_noise_covariance([4.5])).estimate_covariance
+    np.testing.assert_allclose(line(growth_ax, background.REFERENCE_LABEL)[0],
+                               2 * np.sqrt(P[0, 0]), rtol=1e-12)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import io
 import math
 
 import numpy as np
@@ -65,6 +67,8 @@ def test_sliders_follow_the_conventions(explorer) -> None:
     assert sigma_v.value == DEFAULT.sigma_v
     for slider in (b, sigma_a, sigma_v):
         assert slider.continuous_update is False
+        # The readout must read back what it shows: no thousands separators.
+        assert "," not in slider.readout_format
 
 
 @pytest.mark.parametrize(("name", "value"),
@@ -180,3 +184,47 @@ def test_static_display_carries_the_picture(explorer) -> None:
     for description in ("b (cm/s²)", "σ_a (cm/s²)", "σ_v (cm)"):
         assert description in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+
+
+def png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
+    reused = Figure(figsize=(10, 4.6))
+    for values in ({"bias": -55.0, "sigma_a": 300.0, "sigma_v": 4.5},
+                   {"bias": 20.0, "sigma_a": 20.0, "sigma_v": 1.5},
+                   {"bias": 60.0, "sigma_a": 1.0, "sigma_v": 0.5}):
+        bias_explorer.draw_bias(reused, **values)
+        fresh = Figure(figsize=(10, 4.6))
+        bias_explorer.draw_bias(fresh, **values)
+        assert png(reused) == png(fresh)
+    assert len(reused.axes) == 2
+
+
+def test_foreign_or_cleared_figure_is_rebuilt() -> None:
+    figure = Figure()
+    figure.add_subplot().plot([0, 1], [5, 6], label="someone else's line")
+    bias_explorer.draw_bias(figure, bias=10.0, sigma_a=20.0, sigma_v=1.5)
+    bias_ax, path_ax = figure.axes
+    assert "someone else's line" not in [line.get_label() for line in path_ax.get_lines()]
+    figure.clear()
+    bias_explorer.draw_bias(figure, bias=-10.0, sigma_a=20.0, sigma_v=1.5)
+    bias_ax, path_ax = figure.axes
+    assert "b = -10 cm/s²" in bias_ax.get_title()
+    assert len(bias_ax.get_lines()) == 2
+    assert len(path_ax.get_lines()) == 4
+
+
+def test_another_scenario_rebuilds_the_panels() -> None:
+    """The fixed artists (the true path) follow the scenario a figure is drawn for."""
+    figure = Figure()
+    bias_explorer.draw_bias(figure, bias=0.0, sigma_a=20.0, sigma_v=1.5)
+    wider = dataclasses.replace(DEFAULT, amplitude=15.0)
+    bias_explorer.draw_bias(figure, bias=0.0, sigma_a=20.0, sigma_v=1.5, scenario=wider)
+    path_ax = figure.axes[1]
+    np.testing.assert_array_equal(line(path_ax, bias_explorer.TRUTH_LABEL),
+                                  wider.truth[SHOWN, 0])
+    assert path_ax.get_ylim() == (-30.0, 30.0)

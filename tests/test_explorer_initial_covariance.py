@@ -49,6 +49,7 @@ def test_slider_is_logarithmic_over_the_documented_range(explorer) -> None:
     assert slider.step == pytest.approx(1 / ic.P0_STEPS_PER_DECADE)
     assert slider.value == DEFAULT.p0_variance
     assert slider.continuous_update is False
+    assert slider.readout_format == ".3g"
     # The question's two values are reachable slider positions.
     for value in (1.0, 1e5):
         position = (np.log10(value) - slider.min) / slider.step

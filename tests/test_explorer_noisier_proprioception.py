@@ -74,7 +74,7 @@ def _check_figure(figure: Figure, sigma_p: float, noise: np.ndarray,
     # Proprioception's weight is its share of the reliabilities 1/σ².
     weight = sigma_v**2 / (sigma_v**2 + sigma_p**2)
     theory_ax = figure.axes[2]
-    assert f"proprioception's weight: {100 * weight:.0f} %" in theory_ax.get_title()
+    assert f"proprioception's weight: {100 * weight:.1f} %" in theory_ax.get_title()
     skip = scenario.burn_in_steps
     title = figure.get_suptitle()
     assert f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm" in title
@@ -210,3 +210,24 @@ def test_bad_inputs_to_the_theory_raise():
         steady_position_variances(DEFAULT, 0.0, np.array([1.0]))
     with pytest.raises(ValueError, match="noise must have shape"):
         draw_noisier_proprioception(_fresh_figure(), sigma_p=4.5, noise=np.zeros((3, 2)))
+
+
+def test_static_display_carries_the_picture_and_names_the_sliders():
+    explorer = explore_noisier_proprioception()
+    bundle = explorer._repr_mimebundle_()
+    assert bundle["text/plain"].startswith("Interactive explorer")
+    for description in ("σ_p (cm)",):
+        assert description in bundle["text/html"]
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
+    figure = _fresh_figure()
+    draw_noisier_proprioception(figure, sigma_p=30.0)
+    theory_ax = figure.axes[2]
+    figure.canvas.draw()
+    labels = [label.get_text() for label in theory_ax.get_xticklabels()]
+    assert labels == ["0.3", "1", "3", "10", "30", "100"]
+    assert theory_ax.get_xticklabels(minor=True) == []
+    # At σ_p = 30 cm proprioception still has a weight: 2.25 / (2.25 + 900) ≈ 0.25 %.
+    assert theory_ax.get_title().endswith("proprioception's weight: 0.2 %")

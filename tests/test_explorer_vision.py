@@ -47,6 +47,10 @@ def test_slider_follows_the_conventions(explorer) -> None:
     assert slider.value == DEFAULT.sigma_v
     assert slider.continuous_update is False
     assert slider.readout_format == ".1f"
+    # The question's two values are reachable slider positions.
+    for value in (1.5, 4.5):
+        position = (value - slider.min) / slider.step
+        assert position == pytest.approx(round(position))
 
 
 @pytest.mark.parametrize("sigma_v", [0.1, 4.5, 10.0, 1.5])

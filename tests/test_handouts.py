@@ -1,7 +1,9 @@
 """HTML handouts: one offline page per notebook, figures embedded, explorers static.
 
 The handouts of a small fixture folder and of ``notebooks/`` are each built once per
-test session (every notebook executed fresh once); the tests parse the pages.
+test session (every notebook executed fresh once); the tests parse the pages. The
+page checks are plain functions; a few tests feed them broken HTML to show that they
+can fail.
 """
 
 from __future__ import annotations
@@ -9,12 +11,15 @@ from __future__ import annotations
 import base64
 import hashlib
 import re
+from collections import Counter
 from pathlib import Path
+from urllib.parse import unquote, urlsplit
 
 import nbformat
 import pytest
+import soupsieve
 from bs4 import BeautifulSoup
-from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers import handouts
 from lqe_helpers.student_edition import EXPLORER_TAG
@@ -24,6 +29,9 @@ REAL = sorted(path.stem for path in NOTEBOOKS.glob("*.ipynb"))
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 IMAGE_TYPES = ("image/png", "image/jpeg", "image/svg+xml")
+REMOVE_TAGS = {"remove-cell"}
+# What a page shows of a code cell's input (the prose variant shows none of it).
+CODE_INPUT = ".jp-CodeCell .jp-InputArea, .jp-InputPrompt, .jp-OutputPrompt"
 
 # A 1×1 PNG for a markdown image that must be embedded.
 PIXEL = base64.b64decode(
@@ -33,10 +41,12 @@ MATH_INLINE = r"P(k+1) = F P F^\top + G \sigma^2 G^\top"
 MATH_DISPLAY = r"\hat z(k+1 \mid k) = A \hat z(k \mid k) < 1"
 CELLS = [
     new_markdown_cell(f"# Fixture handout\n\nPrediction: ${MATH_INLINE}$.\n\n$${MATH_DISPLAY}$$\n\n"
-                      "![a pixel](pixel.png)"),
+                      "![a pixel](pixel.png)\n\nNext: [the other page](02_fixture_again.ipynb#Top),"
+                      " [elsewhere](99_not_built.ipynb)."),
     new_code_cell("import matplotlib.pyplot as plt\nimport numpy as np"),
     new_code_cell("fig, ax = plt.subplots()\nax.plot(np.arange(3), label='truth')\nplt.show()\n"
-                  "print('printed result 0.383')", metadata={"tags": ["solution"]}),
+                  "print('printed result 0.383')", metadata={"tags": ["solution"]},
+                  outputs=[new_output("stream", name="stdout", text="stale output of a past run")]),
     new_code_cell("print('hidden helper text')", metadata={"tags": ["remove-cell"]}),
     new_code_cell(
         "from lqe_helpers.explorer import Explorer, float_slider\n\n\n"
@@ -61,6 +71,10 @@ def soup(path: Path) -> BeautifulSoup:
     return BeautifulSoup(path.read_text(encoding="utf-8"), "html.parser")
 
 
+def tags(cell: nbformat.NotebookNode) -> set[str]:
+    return set(cell.get("metadata", {}).get("tags", []))
+
+
 def output_figures(notebook: nbformat.NotebookNode) -> int:
     """How many figure outputs (any image mimetype) the notebook's cells hold."""
     return sum(
@@ -70,14 +84,17 @@ def output_figures(notebook: nbformat.NotebookNode) -> int:
     )
 
 
-def math_in(notebook: nbformat.NotebookNode) -> list[str]:
-    """The LaTeX source of every $...$ / $$...$$ span in the markdown cells."""
-    spans = []
-    for cell in notebook.cells:
-        if cell.cell_type == "markdown":
-            spans += re.findall(r"\$\$(.+?)\$\$", cell.source, flags=re.S)
-            spans += re.findall(r"(?<!\$)\$([^$\n]+)\$(?!\$)", cell.source)
-    return spans
+def delimited_math(text: str) -> list[str]:
+    """Every ``$$...$$`` and ``$...$`` span of ``text`` (delimiters kept, spaces squashed)."""
+    text = " ".join(text.split())
+    return (re.findall(r"\$\$.+?\$\$", text)
+            + re.findall(r"(?<!\$)\$[^$]+\$(?!\$)", re.sub(r"\$\$.+?\$\$", " ", text)))
+
+
+def math_in(notebook: nbformat.NotebookNode) -> Counter:
+    """How often each LaTeX span (with its delimiters) occurs in the markdown cells."""
+    return Counter(span for cell in notebook.cells if cell.cell_type == "markdown"
+                   for span in delimited_math(cell.source))
 
 
 def squash(text: str) -> str:
@@ -92,22 +109,147 @@ def assert_offline(page: BeautifulSoup, mathjax_url: str) -> None:
     for script in page.find_all("script", src=True):
         assert script["src"] == mathjax_url, script["src"]
         assert script.has_attr("async")
-    for tag in page.find_all(["link", "iframe", "embed", "object", "source", "video", "audio"]):
-        for attribute in ("href", "src", "data"):
+    for tag in page.find_all(["link", "iframe", "embed", "object", "source", "video", "audio",
+                              "image", "use"]):
+        for attribute in ("href", "src", "data", "xlink:href"):
             assert not str(tag.get(attribute, "")).startswith(("http:", "https:", "//")), tag
-    for style in page.find_all("style"):
-        css = style.get_text()
+    for style in [*page.find_all("style"), *page.find_all(style=True)]:
+        css = style.get_text() if style.name == "style" else style["style"]
         assert not re.search(r"@import|url\(\s*['\"]?(https?:)?//", css), css[:80]
 
 
 def assert_no_error_or_widget(page: BeautifulSoup) -> None:
     html = str(page)
     assert page.select('[data-mime-type="application/vnd.jupyter.stderr"]') == []
+    assert page.select(".jp-OutputArea-output.jp-mod-error, .output_error") == []
     assert "Traceback" not in page.get_text()
     assert WIDGET_VIEW not in html
     assert "widget-state" not in html
-    for text in ("Loading widgets", "Interactive explorer:", "VBox(", "FloatSlider("):
+    for text in ("Loading widgets", "Interactive explorer:", "VBox(", "FloatSlider(",
+                 "Error displaying widget", "model not found"):
         assert text not in page.get_text()
+
+
+# Declarations that take an element (and its text) off the screen.
+_HIDING = re.compile(r"(?<![-\w])(?:display\s*:\s*none|visibility\s*:\s*hidden|"
+                     r"(?:font-size|opacity)\s*:\s*0(?![.\d]))")
+_INVISIBLE_PARENTS = {"script", "style", "template", "noscript", "head", "title", "textarea"}
+
+
+def hidden_elements(page: BeautifulSoup) -> list:
+    """Elements that the page's own CSS or attributes hide (states such as :hover aside)."""
+    hidden = [element for element in page.find_all(True)
+              if element.has_attr("hidden") or element.get("aria-hidden") == "true"
+              or _HIDING.search(element.get("style", ""))]
+    for style in page.find_all("style"):
+        for selectors, body in re.findall(r"([^{}]+)\{([^{}]*)\}", style.get_text()):
+            if not _HIDING.search(body):
+                continue
+            for selector in selectors.split(","):
+                try:
+                    hidden += page.select(selector.strip())
+                except (soupsieve.SelectorSyntaxError, NotImplementedError):
+                    continue  # a pseudo-element (::before): generated content, not the page's
+    return hidden
+
+
+def visible_math(page: BeautifulSoup) -> Counter:
+    """The LaTeX spans in text nodes that no tag, attribute or CSS rule keeps off the screen."""
+    hidden = {id(element) for element in hidden_elements(page)}
+    found = Counter()
+    for node in page.find_all(string=True):
+        if not any(parent.name in _INVISIBLE_PARENTS or id(parent) in hidden
+                   for parent in node.parents):
+            found.update(delimited_math(node))
+    return found
+
+
+def assert_visible_math(page: BeautifulSoup, expected: Counter) -> None:
+    """Every LaTeX span of the source is on the page as visible text, as often as in the source.
+
+    This is what a reader sees when MathJax cannot load: the LaTeX source as text.
+    """
+    assert expected, "no equation to look for"
+    missing = expected - visible_math(page)
+    assert not missing, f"LaTeX not visible as text: {sorted(missing)[:5]}"
+
+
+def assert_local_links_resolve(page: BeautifulSoup, folder: Path) -> None:
+    """Every link to a file next to the page points at a file that exists."""
+    for anchor in page.find_all("a", href=True):
+        parts = urlsplit(anchor["href"])
+        if parts.scheme or parts.netloc or not parts.path:
+            continue  # remote, or a fragment within the page
+        assert (folder / unquote(parts.path)).is_file(), anchor["href"]
+
+
+def code_lines(notebook: nbformat.NotebookNode) -> set[str]:
+    """Distinctive code lines of the notebook: long, and not quoted in any markdown cell."""
+    prose = "\n".join(cell.source for cell in notebook.cells if cell.cell_type == "markdown")
+    return {line.strip() for cell in notebook.cells if cell.cell_type == "code"
+            and not tags(cell) & REMOVE_TAGS for line in cell.source.splitlines()
+            if len(line.strip()) >= 20 and line.strip() not in prose}
+
+
+# ------------------------------------------------- the checks themselves can fail
+
+
+def html(body: str, head: str = "") -> BeautifulSoup:
+    return BeautifulSoup(f"<html><head>{head}</head><body>{body}</body></html>", "html.parser")
+
+
+@pytest.mark.parametrize("body", [
+    '<p>$x$</p><img src="figure.png">',
+    '<img src="https://example.org/figure.png">',
+    '<link rel="stylesheet" href="https://example.org/a.css">',
+    '<style>@import url("https://fonts.example.org/a.css");</style>',
+    '<script src="https://example.org/other.js" async></script>',
+    '<script src="https://cdn.example/mathjax.js"></script>',
+])
+def test_the_offline_check_can_fail(body):
+    with pytest.raises(AssertionError):
+        assert_offline(html(body), "https://cdn.example/mathjax.js")
+
+
+@pytest.mark.parametrize("body", [
+    '<div data-mime-type="application/vnd.jupyter.stderr">warning</div>',
+    "<pre>Traceback (most recent call last)</pre>",
+    f'<script type="{WIDGET_VIEW}">{{"model_id": "x"}}</script>',
+    "<pre>VBox(children=(FloatSlider(value=1.0),))</pre>",
+])
+def test_the_error_and_widget_check_can_fail(body):
+    with pytest.raises(AssertionError):
+        assert_no_error_or_widget(html(body))
+
+
+@pytest.mark.parametrize(("body", "head"), [
+    ("<p>no math here</p>", ""),
+    ('<div class="m"><p>$x^2$</p></div>', "<style>.m p { color: red; display: none }</style>"),
+    ('<div class="a"><p>$x^2$</p></div>', "<style>@media screen {.b, .a {visibility:hidden}}"
+                                          "</style>"),
+    ("<p hidden>$x^2$</p>", ""),
+    ('<p style="font-size: 0">$x^2$</p>', ""),
+    ('<script type="math/tex">$x^2$</script>', ""),
+    ("<p>x^2</p>", "<title>$x^2$</title>"),
+])
+def test_the_visible_math_check_can_fail(body, head):
+    expected = Counter({"$x^2$": 1})
+    with pytest.raises(AssertionError):
+        assert_visible_math(html(body, head), expected)
+    shown = html("<main><p>$x^2$</p></main>", "<title>$x^2$</title><style>p:hover {display: none}"
+                 "</style>")
+    assert visible_math(shown) == expected
+    assert_visible_math(shown, expected)
+    with pytest.raises(AssertionError):
+        assert_visible_math(shown, Counter({"$x^2$": 2}))
+
+
+def test_the_link_check_can_fail(tmp_path):
+    (tmp_path / "a.html").write_text("")
+    assert_local_links_resolve(html('<a href="a.html#x">a</a><a href="#y">y</a>'
+                                    '<a href="https://example.org">e</a>'), tmp_path)
+    with pytest.raises(AssertionError):
+        assert_local_links_resolve(html('<a href="b.ipynb">b</a>'), tmp_path)
 
 
 # ---------------------------------------------------------------- the fixture
@@ -131,7 +273,7 @@ def test_fixture_pages_and_layout(fixture_build):
     assert written == [out / "01_fixture.html", out / "02_fixture_again.html", out / "index.html",
                        out / "prose" / "01_fixture.html", out / "prose" / "02_fixture_again.html",
                        out / "prose" / "index.html"]
-    assert all(path.is_file() for path in written)
+    assert sorted(out.rglob("*")) == sorted([*written, out / "prose"])
 
 
 @pytest.mark.parametrize("variant", ["", "prose/"])
@@ -149,17 +291,24 @@ def test_fixture_page_content(fixture_build, variant):
     assert f"data:image/png;base64,{base64.b64encode(PIXEL).decode()}" in sources
     [explorer] = page.select("figure.lqe-explorer")
     assert explorer.img["src"].startswith("data:image/png;base64,")
+    assert "default values" in explorer.figcaption.get_text()
     assert "JupyterLab" in explorer.figcaption.get_text()
 
-    # LaTeX survives as readable text for when MathJax cannot load.
-    assert squash(MATH_INLINE) in text
-    assert squash(MATH_DISPLAY) in text
+    # LaTeX survives as visible text for when MathJax cannot load.
+    assert_visible_math(page, Counter({f"${MATH_INLINE}$": 1, f"$${MATH_DISPLAY}$$": 1}))
+    assert visible_math(page) == math_in(new_notebook(cells=CELLS))
+    # Executed afresh: the new output, not the one saved in the notebook.
     assert "printed result 0.383" in text
+    assert "stale output" not in text
     assert "hidden helper text" not in text  # remove-cell tag honoured
+    # A link to a notebook that has a page goes to the page; any other is left alone.
+    hrefs = [a["href"] for a in page.select(".jp-MarkdownCell a")
+             if "anchor-link" not in a.get("class", [])]
+    assert hrefs == ["02_fixture_again.html#Top", "99_not_built.ipynb"]
 
     code_cells = page.select(".jp-CodeCell .jp-InputArea")
     if variant:
-        assert code_cells == []
+        assert page.select(CODE_INPUT) == []
         assert "import numpy" not in text
         assert "In [" not in text
     else:
@@ -173,6 +322,7 @@ def test_fixture_index_and_navigation(fixture_build, variant):
     index = soup(out / variant / "index.html")
     pages = ["01_fixture.html", "02_fixture_again.html"]
     assert [a["href"] for a in index.select("ol a")] == pages
+    assert [a.get_text() for a in index.select("ol a")] == ["Fixture handout"] * 2
     other = "../index.html" if variant else "prose/index.html"
     assert [a["href"] for a in index.select("p a")] == [other]
     first = soup(out / variant / pages[0])
@@ -181,6 +331,7 @@ def test_fixture_index_and_navigation(fixture_build, variant):
     second = soup(out / variant / pages[1])
     assert [a["href"] for a in second.select("nav.lqe-nav")[0].find_all("a")] == [
         pages[0], "index.html"]
+    assert_local_links_resolve(index, out / variant)
 
 
 def test_without_mathjax_there_is_no_script_at_all(tmp_path):
@@ -188,6 +339,8 @@ def test_without_mathjax_there_is_no_script_at_all(tmp_path):
     written = handouts.build_handouts(tmp_path / "src", tmp_path / "out", mathjax_url="")
     for path in written:
         assert soup(path).find_all("script", src=True) == []
+    assert_visible_math(soup(written[0]), Counter({f"${MATH_INLINE}$": 1,
+                                                    f"$${MATH_DISPLAY}$$": 1}))
 
 
 def test_a_notebook_that_raises_stops_the_build(tmp_path):
@@ -195,6 +348,7 @@ def test_a_notebook_that_raises_stops_the_build(tmp_path):
     expected = r"03_broken\.ipynb: a cell raised ZeroDivisionError"
     with pytest.raises(handouts.HandoutBuildError, match=expected):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
+    assert not (tmp_path / "out").exists()
 
 
 def test_an_allowed_error_still_stops_the_build(tmp_path):
@@ -204,12 +358,39 @@ def test_an_allowed_error_still_stops_the_build(tmp_path):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
 
 
+def test_a_bare_widget_stops_the_build(tmp_path):
+    cells = [new_code_cell("import ipywidgets\nipywidgets.IntSlider(description='n')")]
+    write_fixture(tmp_path / "src", "05_bare_widget", cells)
+    with pytest.raises(handouts.HandoutBuildError, match=r"no static view.*cell 0: IntSlider"):
+        handouts.build_handouts(tmp_path / "src", tmp_path / "out")
+
+
+def test_stderr_is_reported(tmp_path):
+    cells = [new_code_cell("import sys\nprint('careful: deprecated', file=sys.stderr)")]
+    write_fixture(tmp_path / "src", "06_warns", cells)
+    with pytest.warns(handouts.HandoutWarning, match=r"06_warns\.ipynb.*cell 0: careful"):
+        handouts.build_handouts(tmp_path / "src", tmp_path / "out")
+
+
 def test_bad_folders_are_refused(tmp_path):
     with pytest.raises(ValueError, match=r"at least one \.ipynb"):
         handouts.build_handouts(tmp_path, tmp_path / "out")
     write_fixture(tmp_path / "src", cells=CELLS[:1])
     with pytest.raises(ValueError, match="out_dir must differ"):
         handouts.build_handouts(tmp_path / "src", tmp_path / "src")
+
+
+def test_command_line(tmp_path, capsys):
+    write_fixture(tmp_path / "src", cells=CELLS[:1])
+    out = tmp_path / "out"
+    assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(out),
+                          "--mathjax-url", ""]) == 0
+    assert capsys.readouterr().out.split() == [
+        str(out / name) for name in ("01_fixture.html", "index.html", "prose/01_fixture.html",
+                                     "prose/index.html")]
+    write_fixture(tmp_path / "src", "02_broken", [new_code_cell("1 / 0")])
+    assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(out)]) == 1
+    assert "02_broken.ipynb: a cell raised ZeroDivisionError" in capsys.readouterr().err
 
 
 def test_exporter_never_picks_the_widget_view():
@@ -222,10 +403,10 @@ def test_exporter_never_picks_the_widget_view():
     # Even with widget state present the static view is chosen.
     notebook.metadata["widgets"] = {"application/vnd.jupyter.widget-state+json": {
         "state": {"x": {}}, "version_major": 2, "version_minor": 0}}
-    html, _ = exporter.from_notebook_node(notebook, {"metadata": {"name": "w"}})
-    assert "<p>static</p>" in html
-    assert 'type="application/vnd.jupyter.widget-view+json"' not in html
-    assert "unpkg" not in html
+    html_text, _ = exporter.from_notebook_node(notebook, {"metadata": {"name": "w"}})
+    assert "<p>static</p>" in html_text
+    assert 'type="application/vnd.jupyter.widget-view+json"' not in html_text
+    assert "unpkg" not in html_text
 
 
 def test_notebook_title_falls_back_to_the_file_name():
@@ -248,6 +429,10 @@ def pack_build(tmp_path_factory):
     return out, handouts.build_handouts(NOTEBOOKS, out)
 
 
+def test_every_pack_notebook_is_checked():
+    assert len(REAL) >= 7, REAL
+
+
 def test_every_notebook_has_both_pages_and_an_index(pack_build):
     out, written = pack_build
     expected = [out / f"{stem}.html" for stem in REAL] + [out / "index.html"]
@@ -256,6 +441,10 @@ def test_every_notebook_has_both_pages_and_an_index(pack_build):
     for variant in ("", "prose/"):
         index = soup(out / variant / "index.html")
         assert [a["href"] for a in index.select("ol a")] == [f"{stem}.html" for stem in REAL]
+        titles = [soup(out / variant / f"{stem}.html").title.get_text() for stem in REAL]
+        assert [a.get_text() for a in index.select("ol a")] == titles
+        assert_offline(index, handouts.DEFAULT_MATHJAX_URL)
+        assert_local_links_resolve(index, out / variant)
 
 
 @pytest.mark.parametrize("variant", ["", "prose/"])
@@ -266,19 +455,30 @@ def test_pack_page(pack_build, stem, variant):
     source = nbformat.read(NOTEBOOKS / f"{stem}.ipynb", as_version=4)
     assert_offline(page, handouts.DEFAULT_MATHJAX_URL)
     assert_no_error_or_widget(page)
+    assert_local_links_resolve(page, out / variant)
 
     # Every figure of the committed notebook is in the page (explorers included).
-    explorers = sum(EXPLORER_TAG in cell.metadata.get("tags", []) for cell in source.cells)
+    explorers = sum(EXPLORER_TAG in tags(cell) for cell in source.cells)
     in_outputs = [image for image in page.find_all("img")
                   if image.find_parent(class_="jp-OutputArea-output")]
+    assert in_outputs, "a notebook page without a single figure"
     assert len(in_outputs) >= max(output_figures(source), explorers)
     statics = page.select("figure.lqe-explorer")
     assert len(statics) == explorers
     for figure in statics:
+        assert figure.img["src"].startswith("data:image/png;base64,")
         assert "JupyterLab" in figure.figcaption.get_text()
 
-    text = squash(page.get_text())
-    for span in math_in(source):
-        assert squash(span) in text, span
+    # The equations' LaTeX is on the page as visible text (what shows without MathJax).
+    assert_visible_math(page, math_in(source))
+
+    text = page.get_text()
+    shown_code = [line for line in code_lines(source) if line in text]
     if variant:
-        assert page.select(".jp-CodeCell .jp-InputArea") == []
+        assert page.select(CODE_INPUT) == []
+        assert shown_code == []
+    else:
+        code_cells = [cell for cell in source.cells
+                      if cell.cell_type == "code" and not tags(cell) & REMOVE_TAGS]
+        assert len(page.select(".jp-CodeCell .jp-InputArea")) == len(code_cells)
+        assert sorted(shown_code) == sorted(code_lines(source))

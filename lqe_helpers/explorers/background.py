@@ -3,16 +3,23 @@
 Left panel: how fast the position uncertainty grows once the measurements stop
 (Lesson 0.5 eq. (9) with no correction). Right panel: one tracking run at the same
 σ_j, to see the trade-off between lag (σ_j too small) and noise (σ_j too large).
+
+Speed: building the axes, ticks and legends costs more than the filter run, so
+:func:`draw_background` builds the panels once per figure and afterwards only
+replaces the data and titles of the same artists.
 """
 
 from __future__ import annotations
 
 import dataclasses
-from functools import lru_cache, partial
+import weakref
+from functools import partial
 
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.ticker import FixedLocator, FuncFormatter, NullLocator
+from matplotlib.lines import Line2D
+from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
 from .. import experiments, model, validation
 from ..explorer import Explorer, log_slider
@@ -123,27 +130,85 @@ def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
     return f"after {crossing:.2f} s" if crossing is not None else f"after > {loop.times[-1]:g} s"
 
 
-@lru_cache(maxsize=8)
-def _scenario_growth(scenario: Scenario) -> OpenLoop:
-    """Open-loop growth at the scenario's own σ_j: the reference curve, drawn once."""
-    return open_loop(scenario, np.zeros(3), steady_estimate_covariance(scenario),
-                     OPEN_LOOP_DURATION)
+@dataclasses.dataclass(frozen=True)
+class _Panels:
+    """The artists :func:`draw_background` built on one figure, reused by later calls."""
+
+    scenario: Scenario
+    axes: tuple[Axes, Axes]
+    growth: Line2D
+    vision: Line2D
+    estimate: Line2D
+
+    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
+        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
+        growth_ax, track_ax = self.axes
+        return (self.scenario == scenario and figure.axes == list(self.axes)
+                and self.growth in growth_ax.lines and self.vision in track_ax.lines
+                and self.estimate in track_ax.lines)
+
+
+#: Panels already built, by figure (weak: a figure that is gone frees its entry).
+_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
+
+
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Clear ``figure`` and build both panels: fixed artists drawn, the rest empty."""
+    figure.clear()
+    growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
+    reference = open_loop(scenario, np.zeros(3), steady_estimate_covariance(scenario),
+                          OPEN_LOOP_DURATION)
+    growth_ax.plot(reference.times, 2 * reference.position_stds,
+                   **style("reference", label=REFERENCE_LABEL))
+    growth, = growth_ax.plot(reference.times, np.ones_like(reference.times),
+                             **style("prediction", label=GROWTH_LABEL))
+    growth_ax.axhline(scenario.amplitude, color=COLORS["truth"], linewidth=0.8,
+                      label=AMPLITUDE_LABEL)
+    growth_ax.set_yscale("log")
+    growth_ax.set_ylim(1e-2, 1e3)
+    # Decades only, as plain numbers: minor ticks and mathtext labels would double
+    # the time a slider move takes to render.
+    growth_ax.yaxis.set_major_locator(FixedLocator(np.logspace(-2, 3, 6)))
+    growth_ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    growth_ax.yaxis.set_minor_locator(NullLocator())
+    growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
+    growth_ax.set_xlabel("time since the last measurement (s)")
+    growth_ax.set_ylabel("2σ of predicted position (cm)")
+    growth_ax.legend(loc="lower right", fontsize=8)
+
+    times = scenario.times
+    window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
+    empty = np.zeros(int(window.sum()))
+    vision, = track_ax.plot(times[window], empty, **style("vision", label=VISION_LABEL))
+    track_ax.plot(times[window], scenario.truth[window, 0], **style("truth", label=TRUTH_LABEL))
+    estimate, = track_ax.plot(times[window], empty, **style("estimate", label=ESTIMATE_LABEL))
+    track_ax.set_ylim(-1.7 * scenario.amplitude, 1.7 * scenario.amplitude)
+    track_ax.set_xlim(*TRACKING_WINDOW)
+    track_ax.xaxis.set_major_locator(MultipleLocator(1.0))  # fewer labels: faster redraws
+    label_time_position(track_ax)
+    track_ax.legend(loc="upper center", fontsize=8, ncols=3)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.13, wspace=0.22)
+    return _Panels(scenario, (growth_ax, track_ax), growth, vision, estimate)
 
 
 def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEFAULT,
                     noise: np.ndarray | None = None) -> None:
     """Draw open-loop growth and tracking for the jerk noise ``jerk_std`` (cm/s³).
 
-    Clears ``figure``. Left: twice the standard deviation of the predicted position
-    when the measurements stop after the filter has settled (Lesson 0.5 eq. (9)),
-    at ``jerk_std`` and at the scenario's own σ_j, against the flight's amplitude.
+    Left: twice the standard deviation of the predicted position when the
+    measurements stop after the filter has settled (Lesson 0.5 eq. (9)), at
+    ``jerk_std`` and at the scenario's own σ_j, against the flight's amplitude.
     Right: one vision-only tracking run with Q built from ``jerk_std``; the title
     gives this run's MSE after the burn-in and the variance the filter expects.
+
+    A figure not drawn by this function is cleared first; on one it drew before,
+    for the same scenario, the same artists receive the new data (rebuilding the
+    axes would take longer than the filter and the prediction together).
 
     Parameters
     ----------
     figure : matplotlib.figure.Figure
-        Cleared and redrawn.
+        The figure to draw on.
     jerk_std : float
         σ_j behind Q in cm/s³, > 0.
     scenario : Scenario
@@ -160,46 +225,23 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     variant = dataclasses.replace(scenario, jerk_std=jerk_std)
     growth = open_loop(variant, np.zeros(3), steady_estimate_covariance(variant),
                        OPEN_LOOP_DURATION)
-    reference = _scenario_growth(scenario)
     tracking = experiments.track(variant, noise=noise)
     times = scenario.times
     window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
     expected = float(np.mean(tracking.position_variances[scenario.burn_in_steps:]))
 
-    figure.clear()
-    growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
-    growth_ax.plot(reference.times, 2 * reference.position_stds,
-                   **style("reference", label=REFERENCE_LABEL))
-    growth_ax.plot(growth.times, 2 * growth.position_stds, **style("estimate", label=GROWTH_LABEL))
-    growth_ax.axhline(scenario.amplitude, color=COLORS["truth"], linewidth=0.8,
-                      linestyle="--", label=AMPLITUDE_LABEL)
-    growth_ax.set_yscale("log")
-    growth_ax.set_ylim(1e-2, 1e3)
-    # Decades only, as plain numbers: minor ticks and mathtext labels would double
-    # the time a slider move takes to render.
-    growth_ax.yaxis.set_major_locator(FixedLocator(np.logspace(-2, 3, 6)))
-    growth_ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-    growth_ax.yaxis.set_minor_locator(NullLocator())
-    growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
-    growth_ax.set_xlabel("time since the last measurement (s)")
-    growth_ax.set_ylabel("2σ of predicted position (cm)")
+    panels = _PANELS.get(figure)
+    if panels is None or not panels.belong_to(figure, scenario):
+        panels = _PANELS[figure] = _build(figure, scenario)
+    growth_ax, track_ax = panels.axes
+    panels.growth.set_ydata(2 * growth.position_stds)
     growth_ax.set_title(f"σ_j = {format_jerk(jerk_std)} cm/s³: 2σ reaches "
                         f"{scenario.amplitude:g} cm {_crossing_text(growth, scenario.amplitude)}",
                         fontsize=10)
-    growth_ax.legend(loc="lower right", fontsize=8)
-
-    track_ax.plot(times[window], tracking.measurements[window, 0],
-                  **style("vision", label=VISION_LABEL))
-    track_ax.plot(times[window], scenario.truth[window, 0], **style("truth", label=TRUTH_LABEL))
-    track_ax.plot(times[window], tracking.positions[window],
-                  **style("estimate", label=ESTIMATE_LABEL))
+    panels.vision.set_ydata(tracking.measurements[window, 0])
+    panels.estimate.set_ydata(tracking.positions[window])
     track_ax.set_title(f"Tracking: MSE {float(tracking.mse()):.3g} cm², "
                        f"filter expects {expected:.3g} cm²", fontsize=10)
-    track_ax.set_ylim(-1.7 * scenario.amplitude, 1.7 * scenario.amplitude)
-    track_ax.set_xlim(*TRACKING_WINDOW)
-    label_time_position(track_ax)
-    track_ax.legend(loc="upper center", fontsize=8, ncols=3)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.13, wspace=0.22)
 
 
 def explore_background(scenario: Scenario = DEFAULT) -> Explorer:

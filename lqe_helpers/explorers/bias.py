@@ -5,18 +5,28 @@ Left panel: the filter's bias estimate converging to the true bias, with the ±2
 band of its own covariance. Right panel: the hand's path, vision, the filtered
 position and dead reckoning (the signal integrated without vision), which drifts
 away quadratically.
+
+Speed: building the axes, ticks and legends costs more than the filter run, so
+:func:`draw_bias` builds the panels once per figure and afterwards only replaces the
+data and titles of the same artists. Each move filters one run, the one drawn.
 """
 
 from __future__ import annotations
 
+import weakref
+from dataclasses import dataclass
 from functools import partial
 
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model
 from ..explorer import Explorer, float_slider, log_slider
-from ..plotting import label_time_position, plot_band, style
+from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
 #: Slider range of the true bias b (cm/s²): up to 60 % of the path's peak acceleration.
@@ -31,6 +41,8 @@ SIGMA_V_RANGE = (0.5, 6.0)
 SIGMA_V_STEP = 0.5
 #: Fixed y range of the bias panel (cm/s²): every slider value fits, the axes stay put.
 BIAS_AXIS = (-80.0, 80.0)
+#: Spacing of the bias panel's y ticks (cm/s²).
+BIAS_TICK = 40.0
 
 #: Seconds shown (s): the bias settles and dead reckoning leaves the plot well before.
 WINDOW = 4.0
@@ -45,20 +57,94 @@ ESTIMATE_LABEL = "filtered estimate"
 DEAD_RECKONING_LABEL = "dead reckoning"
 
 
+@dataclass(frozen=True)
+class _Panels:
+    """The artists :func:`draw_bias` built on one figure, reused by later calls."""
+
+    scenario: Scenario
+    axes: tuple[Axes, Axes]
+    band: FillBetweenPolyCollection
+    true_bias: Line2D
+    bias_estimate: Line2D
+    vision: Line2D
+    estimate: Line2D
+    dead_reckoning: Line2D
+
+    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
+        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
+        bias_ax, path_ax = self.axes
+        return (self.scenario == scenario and figure.axes == list(self.axes)
+                and self.band in bias_ax.collections
+                and all(line in bias_ax.lines for line in (self.true_bias, self.bias_estimate))
+                and all(line in path_ax.lines
+                        for line in (self.vision, self.estimate, self.dead_reckoning)))
+
+
+#: Panels already built, by figure (weak: a figure that is gone frees its entry).
+_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
+
+
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Clear ``figure`` and build both panels: fixed artists drawn, the rest empty."""
+    figure.clear()
+    bias_ax, path_ax = figure.subplots(1, 2)
+    times = scenario.times[_shown(scenario)]
+    empty = np.zeros_like(times)
+    band = bias_ax.fill_between(times, empty, empty, color=COLORS["estimate"], alpha=0.15,
+                                linewidth=0, label=BIAS_BAND_LABEL)
+    true_bias, = bias_ax.plot(times, empty, **style("truth", label=TRUE_BIAS_LABEL))
+    bias_estimate, = bias_ax.plot(times, empty, **style("estimate", label=BIAS_ESTIMATE_LABEL))
+    bias_ax.set_ylim(*BIAS_AXIS)
+    bias_ax.set_xlim(0, WINDOW)
+    # Fewer tick labels than matplotlib's default: text is most of a redraw's cost.
+    bias_ax.yaxis.set_major_locator(MultipleLocator(BIAS_TICK))
+    bias_ax.set_xlabel("time (s)")
+    bias_ax.set_ylabel("bias (cm/s²)")
+    bias_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=3)
+
+    vision, = path_ax.plot(times, empty, **style("vision", label=VISION_LABEL))
+    path_ax.plot(times, scenario.truth[_shown(scenario), 0], **style("truth", label=TRUTH_LABEL))
+    estimate, = path_ax.plot(times, empty, **style("estimate", label=ESTIMATE_LABEL))
+    dead_reckoning, = path_ax.plot(times, empty,
+                                   **style("alternative", label=DEAD_RECKONING_LABEL))
+    limit = 2.0 * scenario.amplitude
+    path_ax.set_ylim(-limit, limit)
+    path_ax.set_xlim(0, WINDOW)
+    path_ax.yaxis.set_major_locator(MultipleLocator(scenario.amplitude))
+    for ax in (bias_ax, path_ax):
+        ax.xaxis.set_major_locator(MultipleLocator(1.0))
+    label_time_position(path_ax)
+    path_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=4,
+                   markerscale=2, columnspacing=1.0, handlelength=1.8)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.22, wspace=0.2)
+    return _Panels(scenario, (bias_ax, path_ax), band, true_bias, bias_estimate, vision,
+                   estimate, dead_reckoning)
+
+
+def _shown(scenario: Scenario) -> np.ndarray:
+    """Samples drawn: the first :data:`WINDOW` seconds."""
+    return scenario.times <= WINDOW
+
+
 def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
               scenario: Scenario = DEFAULT, noise: np.ndarray | None = None) -> None:
     """Draw one run of the biased-input filter and of dead reckoning.
 
-    Clears ``figure``. Left: the bias estimate b̂ with ±2 standard deviations of the
-    filter's own bias variance, and the true bias. Right: the true path, vision's
-    samples, the filtered position and the dead-reckoned position, whose distance
-    from the path at the end of the trial is given in the title with this run's
-    filtered MSE after the burn-in.
+    Left: the bias estimate b̂ with ±2 standard deviations of the filter's own bias
+    variance, and the true bias; the title gives the estimate at the end of the
+    trial. Right: the true path, vision's samples, the filtered position and the
+    dead-reckoned position, whose distance from the path at the end of the trial is
+    given in the title with this run's filtered MSE after the burn-in. Only the
+    first :data:`WINDOW` seconds are drawn; the titles cover the whole trial.
+
+    A figure not drawn by this function is cleared first; on one it drew before,
+    for the same scenario, the same artists receive the new data (rebuilding the
+    axes would take longer than the filter run).
 
     Parameters
     ----------
     figure : matplotlib.figure.Figure
-        Cleared and redrawn.
+        The figure to draw on.
     bias : float
         True bias b of the acceleration signal in cm/s².
     sigma_a : float
@@ -78,39 +164,26 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
     """
     tracking = bias_model.track_with_input(scenario, bias=bias, sigma_a=sigma_a,
                                            sigma_v=sigma_v, noise=noise)
-    shown = scenario.times <= WINDOW
+    shown = _shown(scenario)
     times = scenario.times[shown]
     end_error = float(tracking.dead_reckoning[-1, 0] - tracking.truth[-1, 0])
-
-    figure.clear()
-    bias_ax, path_ax = figure.subplots(1, 2)
     estimate, std = tracking.bias_estimates[shown], tracking.bias_stds[shown]
-    plot_band(bias_ax, times, estimate, std, label=BIAS_BAND_LABEL)
-    bias_ax.plot(times, tracking.truth[shown, 2], **style("truth", label=TRUE_BIAS_LABEL))
-    bias_ax.plot(times, estimate, **style("estimate", label=BIAS_ESTIMATE_LABEL))
-    bias_ax.set_ylim(*BIAS_AXIS)
-    bias_ax.set_xlim(0, WINDOW)
-    bias_ax.set_xlabel("time (s)")
-    bias_ax.set_ylabel("bias (cm/s²)")
+
+    panels = _PANELS.get(figure)
+    if panels is None or not panels.belong_to(figure, scenario):
+        panels = _PANELS[figure] = _build(figure, scenario)
+    bias_ax, path_ax = panels.axes
+    panels.band.set_data(times, estimate - 2 * std, estimate + 2 * std)
+    panels.true_bias.set_ydata(tracking.truth[shown, 2])
+    panels.bias_estimate.set_ydata(estimate)
     bias_ax.set_title(f"b = {tracking.bias:g} cm/s²; estimate at {scenario.duration:g} s: "
                       f"{tracking.bias_estimates[-1]:.1f} ± {2 * tracking.bias_stds[-1]:.1f}",
                       fontsize=10)
-    bias_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=3)
-
-    path_ax.plot(times, tracking.measurements[shown, 0], **style("vision", label=VISION_LABEL))
-    path_ax.plot(times, tracking.truth[shown, 0], **style("truth", label=TRUTH_LABEL))
-    path_ax.plot(times, tracking.positions[shown], **style("estimate", label=ESTIMATE_LABEL))
-    path_ax.plot(times, tracking.dead_reckoning[shown, 0],
-                 **style("alternative", label=DEAD_RECKONING_LABEL))
-    limit = 2.0 * scenario.amplitude
-    path_ax.set_ylim(-limit, limit)
-    path_ax.set_xlim(0, WINDOW)
-    label_time_position(path_ax)
+    panels.vision.set_ydata(tracking.measurements[shown, 0])
+    panels.estimate.set_ydata(tracking.positions[shown])
+    panels.dead_reckoning.set_ydata(tracking.dead_reckoning[shown, 0])
     path_ax.set_title(f"MSE {float(tracking.mse()):.3g} cm²; dead reckoning "
                       f"{end_error:+.0f} cm off at {scenario.duration:g} s", fontsize=10)
-    path_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=4,
-                   markerscale=2, columnspacing=1.0, handlelength=1.8)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.22, wspace=0.2)
 
 
 def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:

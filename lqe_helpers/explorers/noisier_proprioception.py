@@ -14,13 +14,14 @@ from functools import partial
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullLocator
 
 from .. import experiments, model, validation
 from ..explorer import Explorer, float_slider
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
-from .fusion import FUSED, unit_noise
+from .fusion import FUSED, pin_axis_labels, unit_noise, vision_only
 
 #: σ_p (cm) of question (d), where the slider starts.
 QUESTION_SIGMA_P = 4.5
@@ -120,7 +121,7 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     sigma_p = validation.positive("sigma_p", sigma_p, "cm")
     noise = unit_noise(scenario, noise)
     sigma_v = scenario.sigma_v
-    vision = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
+    vision = vision_only(scenario, sigma_v, noise)
     fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
     truth = scenario.truth[:, 0]
     _, theory_now = steady_position_variances(scenario, sigma_v, np.array([sigma_p]))
@@ -142,7 +143,7 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
                 line.set_ydata(data[line.get_gid()])
     (marker,) = [line for line in theory.lines if line.get_gid() == "theory now"]
     marker.set_data([sigma_p], theory_now)
-    theory.set_title(f"steady state\nproprioception's weight: {100 * weight_p:.0f} %",
+    theory.set_title(f"steady state\nproprioception's weight: {100 * weight_p:.1f} %",
                      fontsize=10)
     figure.suptitle(
         f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
@@ -197,10 +198,15 @@ def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
                 color=COLORS["estimate"], label="slider's σ_p")
     theory.set_xscale("log")
     theory.set_xlim(*CURVE_RANGE)
+    # Plain labels, as in the notebook's Figure 3 (mathtext powers of ten render slowly).
+    ticks = [0.3, 1.0, 3.0, 10.0, 30.0, 100.0]
+    theory.set_xticks(ticks, [f"{tick:g}" for tick in ticks])
+    theory.xaxis.set_minor_locator(NullLocator())
     theory.set_ylim(0.0, 1.15 * level)
-    theory.set_xlabel("σ_p (cm)")
+    theory.set_xlabel("σ_p (cm), log scale")
     theory.set_ylabel("steady-state position variance (cm²)")
     theory.legend(loc="lower right", fontsize=8)
+    pin_axis_labels(figure)
     return signals, errors, theory
 
 
