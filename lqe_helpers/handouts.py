@@ -345,7 +345,8 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     ValueError
         If ``source_dir`` holds no notebook or ``out_dir`` is ``source_dir``.
     HandoutBuildError
-        If a notebook raises or shows an error output.
+        If a notebook raises, shows an error output or displays a widget with
+        no static view.
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
     paths = source_notebooks(source_dir)
