@@ -198,3 +198,66 @@ def convergence_time_ci95(squared_errors: np.ndarray, dt: float, rng: np.random.
     times = convergence_time(curves, dt, factor)
     low, high = np.percentile(times, [2.5, 97.5])
     return Interval(estimate, float(low), float(high), runs)
+
+
+@dataclass(frozen=True)
+class SinusoidFit:
+    """Least-squares fit ``amplitude · sin(2π f (t + lead))`` of signals to a known frequency.
+
+    Attributes
+    ----------
+    amplitude : ndarray, shape (...)
+        Amplitude of the fitted sinusoid, in the signal's unit (e.g. cm).
+    lead : ndarray, shape (...)
+        Time shift in s against ``sin(2π f t)``: > 0 means the signal runs ahead of
+        it, < 0 that it lags behind. Within ± half a period.
+    """
+
+    amplitude: np.ndarray
+    lead: np.ndarray
+
+
+def fit_sinusoid(times: np.ndarray, signal: np.ndarray, frequency: float) -> SinusoidFit:
+    """Amplitude and time lead of the best sinusoid of ``frequency`` through ``signal``.
+
+    Solves ``signal ≈ a sin(ωt) + b cos(ωt)`` (ω = 2π f) by linear least squares over
+    the samples, then writes it as ``R sin(ω (t + lead))`` with ``R = √(a² + b²)`` and
+    ``lead = atan2(b, a) / ω``. Compared with the true path ``A sin(ωt)`` this tells
+    whether an estimate overshoots (R > A) and whether it runs ahead (lead > 0) or
+    trails behind (lead < 0).
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times in s (n >= 2, not all equal).
+    signal : array_like, shape (..., n)
+        Signals, one per leading index, in any unit.
+    frequency : float
+        Frequency f in Hz, > 0.
+
+    Returns
+    -------
+    SinusoidFit
+        ``amplitude`` and ``lead`` with the leading shape of ``signal``.
+    """
+    times = validation.finite_array("times", times, min_ndim=1)
+    signal = validation.finite_array("signal", signal, min_ndim=1)
+    frequency = validation.positive("frequency", frequency, "Hz")
+    if times.ndim != 1 or times.size < 2:
+        raise ValueError(f"times must have shape (n,) with n >= 2, got shape {times.shape}")
+    if signal.shape[-1] != times.size:
+        raise ValueError(
+            f"signal must have shape (..., {times.size}) to match times, got shape "
+            f"{signal.shape}")
+    omega = 2.0 * np.pi * frequency
+    basis = np.stack([np.sin(omega * times), np.cos(omega * times)], axis=1)  # (n, 2)
+    if np.linalg.matrix_rank(basis) < 2:
+        raise ValueError(
+            f"times must span enough of a period of {frequency} Hz to tell sine from cosine, "
+            f"got {times.size} samples from {times[0]} to {times[-1]} s")
+    flat = signal.reshape(-1, times.size).T  # (n, batch)
+    (sine, cosine), *_ = np.linalg.lstsq(basis, flat, rcond=None)
+    shape = signal.shape[:-1]
+    amplitude = np.hypot(sine, cosine).reshape(shape)
+    lead = (np.arctan2(cosine, sine) / omega).reshape(shape)
+    return SinusoidFit(amplitude=amplitude, lead=lead)

@@ -95,3 +95,43 @@ def test_convergence_time_interval_brackets_the_estimate() -> None:
 def test_bad_input(call, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_fit_sinusoid_recovers_amplitude_and_lead():
+    times = np.arange(0.0, 10.0, 0.01)
+    omega = 2 * np.pi * 0.5
+    leads = np.array([0.0, 0.03, -0.2])
+    signal = np.array([[4.0], [10.0], [2.5]]) * np.sin(omega * (times + leads[:, None]))
+    fit = metrics.fit_sinusoid(times, signal, 0.5)
+    np.testing.assert_allclose(fit.amplitude, [4.0, 10.0, 2.5], rtol=1e-12)
+    np.testing.assert_allclose(fit.lead, leads, atol=1e-12)
+
+
+def test_fit_sinusoid_sign_matches_a_shifted_copy():
+    # A signal that reaches its peak 0.05 s before sin(ωt) leads by +0.05 s.
+    times = np.linspace(0.0, 4.0, 401)
+    late = metrics.fit_sinusoid(times, np.sin(np.pi * (times - 0.05)), 0.5)
+    assert late.lead == pytest.approx(-0.05, abs=1e-12)
+    assert late.amplitude == pytest.approx(1.0)
+
+
+def test_fit_sinusoid_ignores_independent_noise_on_average():
+    rng = np.random.default_rng(3)
+    times = np.arange(0.0, 10.0, 0.01)
+    signal = 10 * np.sin(np.pi * times) + rng.standard_normal((200, times.size))
+    fit = metrics.fit_sinusoid(times, signal, 0.5)
+    assert abs(fit.amplitude.mean() - 10.0) < 0.01
+    assert abs(fit.lead.mean()) < 1e-3
+    assert fit.amplitude.shape == (200,)
+
+
+@pytest.mark.parametrize(("times", "signal", "frequency", "name"), [
+    (np.arange(5.0), np.zeros(4), 0.5, "signal"),
+    (np.zeros((2, 2)), np.zeros(2), 0.5, "times"),
+    (np.arange(5.0), np.zeros(5), 0.0, "frequency"),
+    (np.arange(5.0), np.array([0, 1, np.nan, 0, 1]), 0.5, "signal"),
+    (np.arange(5.0), np.zeros(5), 1.0, "times"),  # samples at whole periods: sin(ωt) = 0
+])
+def test_fit_sinusoid_bad_input(times, signal, frequency, name):
+    with pytest.raises(ValueError, match=name):
+        metrics.fit_sinusoid(times, signal, frequency)
