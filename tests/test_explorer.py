@@ -3,11 +3,29 @@
 from __future__ import annotations
 
 import base64
+import dataclasses
+import gc
+import importlib
+import io
+import weakref
+from typing import NamedTuple
 
 import numpy as np
 import pytest
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.text import Text
 
-from lqe_helpers.explorer import Explorer, float_slider, log_slider
+from lqe_helpers.explorer import (
+    Explorer,
+    float_slider,
+    log_slider,
+    pin_axis_labels,
+    reuse_panels,
+)
+from lqe_helpers.scenario import DEFAULT
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -75,3 +93,189 @@ def test_static_fallback_shows_the_current_figure_and_a_note():
     html = bundle["text/html"]
     assert bundle["image/png"] in html
     assert "JupyterLab" in html and "s (cm)" in html
+
+
+# reuse_panels: build a figure's panels once, refill them on later calls.
+
+class Panels(NamedTuple):
+    ax: Axes
+    lines: dict[str, Line2D]
+    title: Text
+
+
+class CountingBuild:
+    """A panel builder that records every call (and checks the figure is empty)."""
+
+    def __init__(self) -> None:
+        self.calls: list[object] = []
+
+    def __call__(self, figure: Figure, key: object) -> Panels:
+        assert figure.axes == [] and figure.texts == [], "build must get a cleared figure"
+        self.calls.append(key)
+        ax = figure.add_subplot()
+        lines = {name: ax.plot([0.0, 1.0], [0.0, 0.0], gid=name)[0] for name in ("a", "b")}
+        return Panels(ax, lines, figure.suptitle(f"built for {key}"))
+
+
+def test_panels_are_built_once_per_figure_and_key():
+    build, figure = CountingBuild(), Figure()
+    first = reuse_panels(figure, build, "key")
+    first.lines["a"].set_ydata([1.0, 2.0])
+    for _ in range(3):
+        assert reuse_panels(figure, build, "key") is first
+    assert build.calls == ["key"]
+    assert figure.axes == [first.ax]
+    np.testing.assert_array_equal(figure.axes[0].lines[0].get_ydata(), [1.0, 2.0])
+    # Keys are compared with ==, not identity.
+    assert reuse_panels(figure, build, ("a", 1)) is not first
+    assert reuse_panels(figure, build, ("a", 1 + 0)) is reuse_panels(figure, build, ("a", 1))
+
+
+def test_another_key_or_builder_rebuilds_on_a_cleared_figure():
+    build, other_build, figure = CountingBuild(), CountingBuild(), Figure()
+    first = reuse_panels(figure, build, 1)
+    second = reuse_panels(figure, build, 2)
+    assert second.ax is not first.ax and figure.axes == [second.ax]
+    assert first.lines["a"] not in figure.axes[0].lines
+    assert figure.get_suptitle() == "built for 2"
+    third = reuse_panels(figure, other_build, 2)
+    assert third.ax is not second.ax and figure.axes == [third.ax]
+    # Back to the first builder and key: the figure shows other panels now, so rebuild.
+    assert reuse_panels(figure, build, 1) is not first
+    assert (build.calls, other_build.calls) == ([1, 2, 1], [2])
+
+
+def test_each_figure_has_its_own_panels():
+    build, left, right = CountingBuild(), Figure(), Figure()
+    on_left, on_right = reuse_panels(left, build, 0), reuse_panels(right, build, 0)
+    assert on_left.ax is not on_right.ax
+    assert reuse_panels(left, build, 0) is on_left
+    assert reuse_panels(right, build, 0) is on_right
+    assert len(build.calls) == 2
+
+
+def test_foreign_figure_is_cleared_before_building():
+    build, figure = CountingBuild(), Figure()
+    foreign = figure.subplots(1, 3)
+    figure.suptitle("someone else's title")
+    panels = reuse_panels(figure, build, "key")
+    assert figure.axes == [panels.ax]
+    assert not any(ax in figure.axes for ax in foreign)
+    assert figure.get_suptitle() == "built for key"
+
+
+@pytest.mark.parametrize("change", [
+    "clear figure", "clear axes", "remove line", "remove figure text", "add axes",
+    "remove axes",
+])
+def test_figure_that_no_longer_shows_the_panels_is_rebuilt(change):
+    build, figure = CountingBuild(), Figure()
+    panels = reuse_panels(figure, build, "key")
+    if change == "clear figure":
+        figure.clear()
+    elif change == "clear axes":
+        panels.ax.clear()
+    elif change == "remove line":
+        panels.lines["b"].remove()
+    elif change == "remove figure text":
+        panels.title.remove()
+    elif change == "add axes":
+        figure.add_subplot(2, 2, 4)
+    else:
+        figure.delaxes(panels.ax)
+    rebuilt = reuse_panels(figure, build, "key")
+    assert rebuilt is not panels
+    assert build.calls == ["key", "key"]
+    assert figure.axes == [rebuilt.ax]
+    assert sorted(line.get_gid() for line in rebuilt.ax.lines) == ["a", "b"]
+    assert figure.get_suptitle() == "built for key"
+
+
+def test_artists_added_after_building_do_not_force_a_rebuild():
+    build, figure = CountingBuild(), Figure()
+    panels = reuse_panels(figure, build, "key")
+    span = panels.ax.axvspan(0.0, 0.5)
+    assert reuse_panels(figure, build, "key") is panels
+    span.remove()
+    assert reuse_panels(figure, build, "key") is panels
+    assert len(build.calls) == 1
+
+
+def test_built_panels_do_not_keep_their_figure_alive():
+    figure = Figure()
+    reuse_panels(figure, CountingBuild(), "key")
+    gone = weakref.ref(figure)
+    del figure
+    gc.collect()
+    assert gone() is None
+
+
+def _label_boxes(figure: Figure) -> list[np.ndarray]:
+    """Window extents (px) of every axis label, relative to its axes' lower-left corner."""
+    renderer = figure.canvas.get_renderer()
+    boxes = []
+    for ax in figure.axes:
+        corner = np.array([ax.bbox.x0, ax.bbox.y0])
+        for axis in (ax.xaxis, ax.yaxis):
+            extent = axis.label.get_window_extent(renderer)
+            boxes.append(np.array([extent.p0 - corner, extent.p1 - corner]))
+    return boxes
+
+
+def test_pinned_axis_labels_stay_where_automatic_placement_put_them():
+    figure = Figure(figsize=(10.0, 5.0))
+    FigureCanvasAgg(figure)
+    top, bottom = figure.subplots(2, 1, sharex=True)
+    top.plot([0, 1], [-150, 150])
+    top.set_ylabel("position (cm)")
+    bottom.set_ylabel("error (cm)")
+    bottom.set_xlabel("time (s)")
+    figure.align_ylabels((top, bottom))
+    figure.canvas.draw()
+    automatic = _label_boxes(figure)
+    pin_axis_labels(figure)
+    assert not top.yaxis._autolabelpos and not bottom.xaxis._autolabelpos
+    figure.canvas.draw()
+    for before, after in zip(automatic, _label_boxes(figure), strict=True):
+        np.testing.assert_allclose(after, before, atol=1e-6)
+    # Pinned in axes coordinates: at twice the dpi every offset doubles.
+    figure.set_dpi(2 * figure.get_dpi())
+    figure.canvas.draw()
+    doubled = _label_boxes(figure)
+    for before, after in zip(automatic, doubled, strict=True):
+        assert np.all(np.abs(after - 2 * before) < 2.0)  # text bboxes round to whole pixels
+
+
+#: (module, draw function, slider values) of every explorer in the pack.
+DRAWINGS = [
+    ("background", "draw_background", {"jerk_std": 300.0}),
+    ("vision", "draw_vision", {"sigma_v": 2.0}),
+    ("initial_covariance", "draw_initial_covariance", {"p0_variance": 10.0}),
+    ("fusion", "draw_fusion", {"sigma_v": 2.0, "sigma_p": 3.0}),
+    ("noisier_proprioception", "draw_noisier_proprioception", {"sigma_p": 6.0}),
+    ("delay", "draw_delay", {"delay": 0.1}),
+    ("bias", "draw_bias", {"bias": 20.0, "sigma_a": 50.0, "sigma_v": 2.0}),
+]
+
+
+def _png(figure: Figure) -> bytes:
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=40, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+@pytest.mark.parametrize(("module", "name", "values"), DRAWINGS, ids=[d[0] for d in DRAWINGS])
+def test_every_explorer_keeps_its_panels_until_the_scenario_changes(module, name, values):
+    draw = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), name)
+    figure = Figure(figsize=(10.0, 5.0))
+    draw(figure, **values)
+    axes = list(figure.axes)
+    draw(figure, **values)
+    assert figure.axes == axes
+    other = dataclasses.replace(DEFAULT, seed=DEFAULT.seed + 1, sigma_v=2.5)
+    draw(figure, scenario=other, **values)
+    assert not set(figure.axes) & set(axes)
+    fresh = Figure(figsize=(10.0, 5.0))
+    draw(fresh, scenario=other, **values)
+    assert _png(figure) == _png(fresh)
+

@@ -14,7 +14,6 @@ from lqe_helpers.explorers.fusion import (
     SIGMA_RANGE,
     draw_fusion,
     explore_fusion,
-    pin_axis_labels,
     vision_only,
 )
 from lqe_helpers.filter import kalman_filter
@@ -243,41 +242,6 @@ def test_vision_only_run_is_cached_read_only_and_correct():
     np.testing.assert_allclose(vision_only(DEFAULT, 2.0, other).positions,
                                _independent(2.0, 1.0, other)["vision-only"],
                                rtol=1e-9, atol=1e-9)
-
-
-def _label_boxes(figure: Figure) -> list[np.ndarray]:
-    """Window extents (px) of every axis label, relative to its axes' lower-left corner."""
-    renderer = figure.canvas.get_renderer()
-    boxes = []
-    for ax in figure.axes:
-        corner = np.array([ax.bbox.x0, ax.bbox.y0])
-        for axis in (ax.xaxis, ax.yaxis):
-            extent = axis.label.get_window_extent(renderer)
-            boxes.append(np.array([extent.p0 - corner, extent.p1 - corner]))
-    return boxes
-
-
-def test_pinned_axis_labels_stay_where_automatic_placement_put_them():
-    figure = _fresh_figure()
-    top, bottom = figure.subplots(2, 1, sharex=True)
-    top.plot([0, 1], [-150, 150])
-    top.set_ylabel("position (cm)")
-    bottom.set_ylabel("error (cm)")
-    bottom.set_xlabel("time (s)")
-    figure.align_ylabels((top, bottom))
-    figure.canvas.draw()
-    automatic = _label_boxes(figure)
-    pin_axis_labels(figure)
-    assert not top.yaxis._autolabelpos and not bottom.xaxis._autolabelpos
-    figure.canvas.draw()
-    for before, after in zip(automatic, _label_boxes(figure), strict=True):
-        np.testing.assert_allclose(after, before, atol=1e-6)
-    # Pinned in axes coordinates: at twice the dpi every offset doubles.
-    figure.set_dpi(2 * figure.get_dpi())
-    figure.canvas.draw()
-    doubled = _label_boxes(figure)
-    for before, after in zip(automatic, doubled, strict=True):
-        assert np.all(np.abs(after - 2 * before) < 2.0)  # text bboxes round to whole pixels
 
 
 def test_static_display_carries_the_picture_and_names_the_sliders():

@@ -12,8 +12,8 @@ replaces the data and titles of the same artists.
 from __future__ import annotations
 
 import dataclasses
-import weakref
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -22,7 +22,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
 from .. import experiments, model, validation
-from ..explorer import Explorer, log_slider
+from ..explorer import Explorer, log_slider, reuse_panels
 from ..plotting import COLORS, label_time_position, style
 from ..prediction import propagate_covariance
 from ..scenario import DEFAULT, Scenario
@@ -130,31 +130,17 @@ def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
     return f"after {crossing:.2f} s" if crossing is not None else f"after > {loop.times[-1]:g} s"
 
 
-@dataclasses.dataclass(frozen=True)
-class _Panels:
-    """The artists :func:`draw_background` built on one figure, reused by later calls."""
+class _Panels(NamedTuple):
+    """The artists :func:`draw_background` builds on a figure and fills on every call."""
 
-    scenario: Scenario
     axes: tuple[Axes, Axes]
     growth: Line2D
     vision: Line2D
     estimate: Line2D
 
-    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
-        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
-        growth_ax, track_ax = self.axes
-        return (self.scenario == scenario and figure.axes == list(self.axes)
-                and self.growth in growth_ax.lines and self.vision in track_ax.lines
-                and self.estimate in track_ax.lines)
-
-
-#: Panels already built, by figure (weak: a figure that is gone frees its entry).
-_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
-
 
 def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Clear ``figure`` and build both panels: fixed artists drawn, the rest empty."""
-    figure.clear()
+    """Build both panels on the empty ``figure``: fixed artists drawn, the rest empty."""
     growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
     reference = open_loop(scenario, np.zeros(3), steady_estimate_covariance(scenario),
                           OPEN_LOOP_DURATION)
@@ -188,7 +174,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     label_time_position(track_ax)
     track_ax.legend(loc="upper center", fontsize=8, ncols=3)
     figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.13, wspace=0.22)
-    return _Panels(scenario, (growth_ax, track_ax), growth, vision, estimate)
+    return _Panels((growth_ax, track_ax), growth, vision, estimate)
 
 
 def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEFAULT,
@@ -230,9 +216,7 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
     expected = float(np.mean(tracking.position_variances[scenario.burn_in_steps:]))
 
-    panels = _PANELS.get(figure)
-    if panels is None or not panels.belong_to(figure, scenario):
-        panels = _PANELS[figure] = _build(figure, scenario)
+    panels = reuse_panels(figure, _build, scenario)
     growth_ax, track_ax = panels.axes
     panels.growth.set_ydata(2 * growth.position_stds)
     growth_ax.set_title(f"σ_j = {format_jerk(jerk_std)} cm/s³: 2σ reaches "

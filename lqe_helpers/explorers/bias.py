@@ -13,9 +13,8 @@ data and titles of the same artists. Each move filters one run, the one drawn.
 
 from __future__ import annotations
 
-import weakref
-from dataclasses import dataclass
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -25,7 +24,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model
-from ..explorer import Explorer, float_slider, log_slider
+from ..explorer import Explorer, float_slider, log_slider, reuse_panels
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -57,11 +56,9 @@ ESTIMATE_LABEL = "filtered estimate"
 DEAD_RECKONING_LABEL = "dead reckoning"
 
 
-@dataclass(frozen=True)
-class _Panels:
-    """The artists :func:`draw_bias` built on one figure, reused by later calls."""
+class _Panels(NamedTuple):
+    """The artists :func:`draw_bias` builds on a figure and fills on every call."""
 
-    scenario: Scenario
     axes: tuple[Axes, Axes]
     band: FillBetweenPolyCollection
     true_bias: Line2D
@@ -70,23 +67,9 @@ class _Panels:
     estimate: Line2D
     dead_reckoning: Line2D
 
-    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
-        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
-        bias_ax, path_ax = self.axes
-        return (self.scenario == scenario and figure.axes == list(self.axes)
-                and self.band in bias_ax.collections
-                and all(line in bias_ax.lines for line in (self.true_bias, self.bias_estimate))
-                and all(line in path_ax.lines
-                        for line in (self.vision, self.estimate, self.dead_reckoning)))
-
-
-#: Panels already built, by figure (weak: a figure that is gone frees its entry).
-_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
-
 
 def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Clear ``figure`` and build both panels: fixed artists drawn, the rest empty."""
-    figure.clear()
+    """Build both panels on the empty ``figure``: fixed artists drawn, the rest empty."""
     bias_ax, path_ax = figure.subplots(1, 2)
     times = scenario.times[_shown(scenario)]
     empty = np.zeros_like(times)
@@ -117,7 +100,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     path_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=4,
                    markerscale=2, columnspacing=1.0, handlelength=1.8)
     figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.22, wspace=0.2)
-    return _Panels(scenario, (bias_ax, path_ax), band, true_bias, bias_estimate, vision,
+    return _Panels((bias_ax, path_ax), band, true_bias, bias_estimate, vision,
                    estimate, dead_reckoning)
 
 
@@ -169,9 +152,7 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
     end_error = float(tracking.dead_reckoning[-1, 0] - tracking.truth[-1, 0])
     estimate, std = tracking.bias_estimates[shown], tracking.bias_stds[shown]
 
-    panels = _PANELS.get(figure)
-    if panels is None or not panels.belong_to(figure, scenario):
-        panels = _PANELS[figure] = _build(figure, scenario)
+    panels = reuse_panels(figure, _build, scenario)
     bias_ax, path_ax = panels.axes
     panels.band.set_data(times, estimate - 2 * std, estimate + 2 * std)
     panels.true_bias.set_ydata(tracking.truth[shown, 2])

@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import math
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from .. import experiments
-from ..explorer import Explorer, float_slider
+from ..explorer import Explorer, float_slider, reuse_panels
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -44,6 +46,15 @@ _LINES = {
 _SPAN = "nothing-yet"
 _SPAN_STYLE = {"color": COLORS["vision"], "alpha": 0.2, "linewidth": 0, "gid": _SPAN,
                "zorder": 0}
+#: Smallest y half-range (in units of the flight's amplitude) of each axes.
+_FLOORS = (1.5, 0.8)
+
+
+class _Panels(NamedTuple):
+    """The axes :func:`draw_delay` builds on a figure and the lines it fills, by gid."""
+
+    axes: tuple[Axes, Axes]
+    lines: dict[str, Line2D]
 
 
 def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
@@ -94,7 +105,7 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
 
     truth = scenario.truth[:, 0]
     shown = scenario.times <= min(WINDOW, scenario.duration)
-    top, bottom = _layout(figure, scenario)
+    panels = reuse_panels(figure, _build, scenario)
     data = {
         "vision": delayed.delayed_measurements[:, 0],
         "truth": truth,
@@ -103,18 +114,17 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
         "delayed-error": delayed.delayed_estimates[:, 0] - truth,
         "prediction-error": delayed.predictions[:, 0] - truth,
     }
-    for ax in (top, bottom):
-        largest = 0.0
-        for line in ax.lines:
-            if line.get_gid() in data:
-                values = data[line.get_gid()][shown]
-                line.set_data(scenario.times[shown], values)
-                if np.any(np.isfinite(values)):
-                    largest = max(largest, float(np.nanmax(np.abs(values))))
+    largest = [0.0] * len(panels.axes)
+    for gid, values in data.items():
+        values = values[shown]
+        panels.lines[gid].set_data(scenario.times[shown], values)
+        if np.any(np.isfinite(values)):
+            index = _LINES[gid][0]
+            largest[index] = max(largest[index], float(np.nanmax(np.abs(values))))
+    for ax, floor, extent in zip(panels.axes, _FLOORS, largest, strict=True):
         # Fixed limits while everything fits, so small changes stay comparable; wider
         # ones when a long extrapolation overshoots, so the overshoot stays visible.
-        floor = (1.5 if ax is top else 0.8) * scenario.amplitude
-        limit = max(floor, 1.08 * largest)
+        limit = max(floor * scenario.amplitude, 1.08 * extent)
         ax.set_ylim(-limit, limit)
         for patch in [p for p in ax.patches if p.get_gid() == _SPAN]:
             patch.remove()
@@ -128,22 +138,15 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
     )
 
 
-def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes]:
-    """The two axes of :func:`draw_delay`, reused if ``figure`` holds them, else built."""
-    gids = (f"delay-signals-{hash(scenario)}", f"delay-errors-{hash(scenario)}")
-    if tuple(ax.get_gid() for ax in figure.axes) == gids:
-        return figure.axes[0], figure.axes[1]
-    figure.clear()
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Build the two axes of :func:`draw_delay` on the empty ``figure``, lines empty."""
     axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
     figure.subplots_adjust(top=0.865, bottom=0.1, hspace=0.12)
-    for ax, gid in zip(axes, gids, strict=True):
-        ax.set_gid(gid)
-    handles = []
+    lines = {}
     for gid, (index, role, label) in _LINES.items():
         kwargs = {"linewidth": 1.2} if index == 1 else {}
-        (line,) = axes[index].plot([], [], **style(role, label=label, gid=gid, **kwargs))
-        if index == 0:
-            handles.append(line)
+        (lines[gid],) = axes[index].plot([], [], **style(role, label=label, gid=gid, **kwargs))
+    handles = [lines[gid] for gid, (index, _, _) in _LINES.items() if index == 0]
     handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
                          label="nothing has arrived yet"))
     figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.945), ncol=5,
@@ -157,7 +160,7 @@ def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes]:
     bottom.set_ylabel("error (cm)")
     bottom.set_xlim(0.0, min(WINDOW, scenario.duration))
     figure.align_ylabels(axes)
-    return top, bottom
+    return _Panels((top, bottom), lines)
 
 
 def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:

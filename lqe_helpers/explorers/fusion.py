@@ -9,14 +9,20 @@ correction, which follow the reliabilities ``1/σ_v²`` and ``1/σ_p²``.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from functools import lru_cache, partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Rectangle
+from matplotlib.text import Annotation
 
 from .. import experiments, validation
-from ..explorer import Explorer, float_slider
+from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
 from ..plotting import COLORS, plot_band, style
 from ..scenario import DEFAULT, Scenario
 
@@ -26,9 +32,12 @@ FUSED = ("vision", "proprioception")
 #: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_RANGE = (0.5, 6.0, 0.25)
 
-#: Plotted lines by gid: (panel, role, legend label or None).
-#: Panel 0 holds the signals, panel 1 the errors (estimate − true position).
-_LINES = {
+#: A line of a trial's left column: (panel, role, legend label or None). Panel 0
+#: holds the signals, panel 1 the errors (estimate − true position).
+TrialLine = tuple[int, str, str | None]
+
+#: Plotted lines by gid.
+_LINES: dict[str, TrialLine] = {
     "vision readings": (0, "vision", "vision readings"),
     "proprioception readings": (0, "proprioception", "proprioception readings"),
     "truth": (0, "truth", "true position"),
@@ -55,24 +64,6 @@ def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarra
             f"noise must have shape {expected} (vision, proprioception), got shape {noise.shape}"
         )
     return noise
-
-
-def pin_axis_labels(figure: Figure) -> None:
-    """Fix every axis label of ``figure`` where automatic placement puts it now.
-
-    Matplotlib places an axis label by measuring the tick labels (of shared and
-    aligned axes too) at every draw. An explorer's panels keep their ticks while
-    the sliders move, so measuring once, when the panels are built, is enough and
-    saves several ms per redraw. Positions are stored in axes coordinates, so the
-    figure can still be saved at any dpi.
-    """
-    figure.draw_without_rendering()
-    for ax in figure.axes:
-        for axis in (ax.xaxis, ax.yaxis):
-            label = axis.label
-            if label.get_text():
-                display = label.get_transform().transform(label.get_position())
-                axis.set_label_coords(*ax.transAxes.inverted().transform(display))
 
 
 @lru_cache(maxsize=16)
@@ -152,29 +143,93 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     position_gain = fused.result.gains[-1, 0, :]
     weights = position_gain / position_gain.sum()
 
-    signals, errors, shares = _layout(figure, scenario)
+    panels = reuse_panels(figure, _build, scenario)
     data = {
         "vision readings": fused.measurements[:, 0],
         "proprioception readings": fused.measurements[:, 1],
+        **estimate_lines(truth, vision, fused),
+    }
+    for gid, values in data.items():
+        panels.trial.lines[gid].set_ydata(values)
+    std = np.sqrt(fused.position_variances)
+    panels.band.set_data(scenario.times, -2 * std, 2 * std)
+    for bar, text, weight in zip(panels.bars, panels.texts, weights, strict=True):
+        bar.set_height(weight)
+        text.set_text(f"{100 * weight:.0f} %")
+        text.xy = (bar.get_x() + bar.get_width() / 2, weight)
+    set_trial_title(figure, scenario, sigma_v, sigma_p, vision, fused)
+
+
+# The trial column (signals over errors) beside a side panel, shared with
+# lqe_helpers.explorers.noisier_proprioception.
+
+
+class TrialPanels(NamedTuple):
+    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
+
+    signals: Axes
+    errors: Axes
+    side: Axes
+    lines: dict[str, Line2D]
+
+
+def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, TrialLine], *,
+                       width_ratios: tuple[float, float], height_ratios: tuple[float, float],
+                       top: float, wspace: float, signal_limit: float,
+                       error_limit: float) -> TrialPanels:
+    """Lay out one trial over ``scenario.times`` beside a side panel, on an empty figure.
+
+    The left column holds the signals (position, ±``signal_limit`` cm) above the
+    errors (estimate − true position, ±``error_limit`` cm, with a zero line); each
+    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data.
+    Shared by this explorer and :mod:`lqe_helpers.explorers.noisier_proprioception`;
+    the caller adds the legend and fills the side panel.
+    """
+    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
+                               left=0.07, right=0.98, bottom=0.1, top=top,
+                               hspace=0.1, wspace=wspace)
+    signals = figure.add_subplot(grid[0, 0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals)
+    side = figure.add_subplot(grid[:, 1])
+    times = scenario.times
+    column = (signals, errors)
+    drawn = {}
+    for gid, (panel, role, label) in lines.items():
+        extra = {"linewidth": 1.0} if panel == 1 else {}
+        (drawn[gid],) = column[panel].plot(times, np.zeros_like(times),
+                                           **style(role, gid=gid, label=label, **extra))
+    signals.set_ylim(-signal_limit, signal_limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.axhline(0.0, **style("truth", linewidth=0.8))
+    errors.set_ylim(-error_limit, error_limit)
+    errors.set_xlim(0.0, scenario.duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels(column)
+    return TrialPanels(signals, errors, side, drawn)
+
+
+def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
+    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
+    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
+
+
+def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,
+                   fused: experiments.Tracking) -> dict[str, np.ndarray]:
+    """y data (cm) of the truth, both estimates and their errors, by line gid."""
+    return {
         "truth": truth,
         "vision-only": vision.positions,
         "fused": fused.positions,
         "vision-only error": vision.positions - truth,
         "fused error": fused.positions - truth,
     }
-    for ax in (signals, errors):
-        for line in ax.lines:
-            if line.get_gid() in data:
-                line.set_ydata(data[line.get_gid()])
-    for band in [c for c in errors.collections if c.get_gid() == _BAND]:
-        band.remove()
-    plot_band(errors, scenario.times, np.zeros(scenario.n_steps),
-              np.sqrt(fused.position_variances))
-    errors.collections[-1].set_gid(_BAND)
-    for bar, text, weight in zip(shares.patches, shares.texts, weights, strict=True):
-        bar.set_height(weight)
-        text.set_text(f"{100 * weight:.0f} %")
-        text.xy = (bar.get_x() + bar.get_width() / 2, weight)
+
+
+def set_trial_title(figure: Figure, scenario: Scenario, sigma_v: float, sigma_p: float,
+                    vision: experiments.Tracking, fused: experiments.Tracking) -> None:
+    """Title ``figure`` with both σ's and the trial's MSEs after the burn-in."""
     figure.suptitle(
         f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
         f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
@@ -183,59 +238,45 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     )
 
 
-def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
-    """The three panels of :func:`draw_fusion`, reused if ``figure`` holds them, else built."""
-    gids = tuple(f"fusion-{name}-{hash(scenario)}" for name in ("signals", "errors", "shares"))
-    if tuple(ax.get_gid() for ax in figure.axes) == gids:
-        return figure.axes[0], figure.axes[1], figure.axes[2]
-    figure.clear()
-    grid = figure.add_gridspec(2, 2, width_ratios=(3.4, 1.0), height_ratios=(1.6, 1.0),
-                               left=0.07, right=0.98, bottom=0.1, top=0.84,
-                               hspace=0.1, wspace=0.25)
-    signals = figure.add_subplot(grid[0, 0], gid=gids[0])
-    errors = figure.add_subplot(grid[1, 0], sharex=signals, gid=gids[1])
-    shares = figure.add_subplot(grid[:, 1], gid=gids[2])
-    times = scenario.times
-    panels = (signals, errors)
-    handles = []
-    for gid, (panel, role, label) in _LINES.items():
-        extra = {"linewidth": 1.0} if panel == 1 else {}
-        (line,) = panels[panel].plot(times, np.zeros_like(times),
-                                     **style(role, gid=gid, label=label, **extra))
-        if label is not None:
-            handles.append(line)
-    plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
-    handles.append(errors.collections[-1])
-    errors.collections[-1].set_gid(_BAND)
-    figure.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.07, 0.945), ncol=3,
-                  fontsize=8, markerscale=2.5)
+class _Panels(NamedTuple):
+    """The artists :func:`draw_fusion` builds on a figure and fills on every call."""
 
-    limit = 1.7 * scenario.amplitude
-    signals.set_ylim(-limit, limit)
-    signals.set_ylabel("position (cm)")
-    signals.tick_params(labelbottom=False)
-    errors.axhline(0.0, **style("truth", linewidth=0.8))
-    errors.set_ylim(-3.5, 3.5)
+    trial: TrialPanels
+    band: FillBetweenPolyCollection
+    bars: tuple[Rectangle, Rectangle]
+    texts: tuple[Annotation, Annotation]
+
+
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Build the three panels of :func:`draw_fusion` on the empty ``figure``, data empty."""
+    trial = build_trial_panels(figure, scenario, _LINES, width_ratios=(3.4, 1.0),
+                               height_ratios=(1.6, 1.0), top=0.84, wspace=0.25,
+                               signal_limit=1.7 * scenario.amplitude, error_limit=3.5)
+    errors, shares = trial.errors, trial.side
+    times = scenario.times
+    plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
+    band = errors.collections[-1]
+    band.set_gid(_BAND)
+    figure.legend(handles=[*legend_handles(trial, _LINES), band], loc="upper left",
+                  bbox_to_anchor=(0.07, 0.945), ncol=3, fontsize=8, markerscale=2.5)
     errors.set_yticks([-2, 0, 2])
-    errors.set_xlim(0.0, scenario.duration)
-    errors.set_xlabel("time (s)")
-    errors.set_ylabel("error (cm)")
-    figure.align_ylabels((signals, errors))
 
     names = ("vision", "proprioception")
     bars = shares.bar([0, 1], [0.5, 0.5], color=[COLORS[name] for name in names],
                       edgecolor="black", linewidth=0.6)
+    texts = []
     for bar, name in zip(bars, names, strict=True):
         bar.set_gid(f"weight {name}")
-        shares.annotate("", (bar.get_x() + bar.get_width() / 2, 0.5), xytext=(0, 3),
-                        textcoords="offset points", ha="center", fontsize=9)
+        texts.append(shares.annotate("", (bar.get_x() + bar.get_width() / 2, 0.5),
+                                     xytext=(0, 3), textcoords="offset points", ha="center",
+                                     fontsize=9))
     shares.set_xticks([0, 1], ["vision", "proprio-\nception"])
     shares.set_ylim(0.0, 1.1)
     shares.set_yticks([0.0, 0.25, 0.5, 0.75, 1.0])
     shares.set_ylabel("share of the position correction")
     shares.set_title("weights ∝ reliability 1/σ²", fontsize=10)
     pin_axis_labels(figure)
-    return signals, errors, shares
+    return _Panels(trial, band, tuple(bars), tuple(texts))
 
 
 def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:

@@ -13,9 +13,8 @@ picture equals a fresh drawing.
 
 from __future__ import annotations
 
-import weakref
-from dataclasses import dataclass
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -26,7 +25,7 @@ from matplotlib.text import Text
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..explorer import Explorer, log_slider
+from ..explorer import Explorer, log_slider, reuse_panels
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -51,32 +50,18 @@ def shown_steps(scenario: Scenario) -> int:
     return min(scenario.n_steps, round(WINDOW / scenario.dt) + 1)
 
 
-@dataclass(frozen=True)
-class _Panels:
-    """The artists :func:`draw_initial_covariance` built on one figure."""
+class _Panels(NamedTuple):
+    """The artists :func:`draw_initial_covariance` builds on a figure and fills on every call."""
 
-    scenario: Scenario
     axes: tuple[Axes, Axes]
     vision: Line2D
     bands: tuple[FillBetweenPolyCollection, FillBetweenPolyCollection]
     estimates: tuple[Line2D, Line2D]
     title: Text
 
-    def belong_to(self, figure: Figure, scenario: Scenario) -> bool:
-        """True if ``figure`` still shows exactly these panels, for ``scenario``."""
-        pairs = zip(self.axes, self.estimates, self.bands, strict=True)
-        return (self.scenario == scenario and figure.axes == list(self.axes)
-                and all(line in ax.lines and band in ax.collections
-                        for ax, line, band in pairs))
-
-
-#: Panels already built, by figure (weak: a figure that is gone frees its entry).
-_PANELS: weakref.WeakKeyDictionary[Figure, _Panels] = weakref.WeakKeyDictionary()
-
 
 def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Clear ``figure`` and build both panels' artists, with no data yet."""
-    figure.clear()
+    """Build both panels' artists on the empty ``figure``, with no data yet."""
     position_ax, velocity_ax = figure.subplots(1, 2)
     times = scenario.times[:shown_steps(scenario)]
     truth = scenario.truth[:times.size]
@@ -99,8 +84,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
                   fontsize=9, markerscale=3)
     title = figure.suptitle("", fontsize=10)
     figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.25, wspace=0.22)
-    return _Panels(scenario, (position_ax, velocity_ax), vision, tuple(bands),
-                   tuple(estimates), title)
+    return _Panels((position_ax, velocity_ax), vision, tuple(bands), tuple(estimates), title)
 
 
 def draw_initial_covariance(figure: Figure, *, p0_variance: float,
@@ -144,9 +128,7 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     estimates = tracking.result.estimates[:shown]
     variances = tracking.result.estimate_covariances[:shown]
 
-    panels = _PANELS.get(figure)
-    if panels is None or not panels.belong_to(figure, scenario):
-        panels = _PANELS[figure] = _build(figure, scenario)
+    panels = reuse_panels(figure, _build, scenario)
     times = scenario.times[:shown]
     panels.vision.set_ydata(measured)
     for column, (band, line) in enumerate(zip(panels.bands, panels.estimates, strict=True)):

@@ -10,18 +10,29 @@ curve approaches but never crosses.
 from __future__ import annotations
 
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
 from .. import experiments, model, validation
-from ..explorer import Explorer, float_slider
+from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
-from .fusion import FUSED, pin_axis_labels, unit_noise, vision_only
+from .fusion import (
+    FUSED,
+    TrialLine,
+    TrialPanels,
+    build_trial_panels,
+    estimate_lines,
+    legend_handles,
+    set_trial_title,
+    unit_noise,
+    vision_only,
+)
 
 #: σ_p (cm) of question (d), where the slider starts.
 QUESTION_SIGMA_P = 4.5
@@ -32,9 +43,8 @@ SIGMA_P_RANGE = (0.5, 30.0, 0.5)
 #: σ_p (cm) spanned by the theoretical curve in the right panel.
 CURVE_RANGE = (0.3, 100.0)
 
-#: Plotted lines by gid: (panel, role, legend label or None).
-#: Panel 0 holds the signals, panel 1 the errors (estimate − true position).
-_LINES = {
+#: Plotted lines of the left column by gid (see :data:`~.fusion.TrialLine`).
+_LINES: dict[str, TrialLine] = {
     "truth": (0, "truth", "true position"),
     "vision-only": (0, "alternative", "vision-only estimate"),
     "fused": (0, "estimate", "fused estimate (vision + proprioception)"),
@@ -129,73 +139,38 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     position_gain = fused.result.gains[-1, 0, :]
     weight_p = float(position_gain[1] / position_gain.sum())
 
-    signals, errors, theory = _layout(figure, scenario)
-    data = {
-        "truth": truth,
-        "vision-only": vision.positions,
-        "fused": fused.positions,
-        "vision-only error": vision.positions - truth,
-        "fused error": fused.positions - truth,
-    }
-    for ax in (signals, errors):
-        for line in ax.lines:
-            if line.get_gid() in data:
-                line.set_ydata(data[line.get_gid()])
-    (marker,) = [line for line in theory.lines if line.get_gid() == "theory now"]
-    marker.set_data([sigma_p], theory_now)
-    theory.set_title(f"steady state\nproprioception's weight: {100 * weight_p:.1f} %",
-                     fontsize=10)
-    figure.suptitle(
-        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
-        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², fused "
-        f"{float(fused.mse()):.3f} cm²",
-        x=0.07, y=0.985, ha="left", fontsize=10,
-    )
+    panels = reuse_panels(figure, _build, scenario)
+    for gid, values in estimate_lines(truth, vision, fused).items():
+        panels.trial.lines[gid].set_ydata(values)
+    panels.marker.set_data([sigma_p], theory_now)
+    panels.trial.side.set_title(
+        f"steady state\nproprioception's weight: {100 * weight_p:.1f} %", fontsize=10)
+    set_trial_title(figure, scenario, sigma_v, sigma_p, vision, fused)
 
 
-def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
-    """The three panels of :func:`draw_noisier_proprioception`, reused or built."""
-    gids = tuple(f"noisier-proprioception-{name}-{hash(scenario)}"
-                 for name in ("signals", "errors", "theory"))
-    if tuple(ax.get_gid() for ax in figure.axes) == gids:
-        return figure.axes[0], figure.axes[1], figure.axes[2]
-    figure.clear()
-    grid = figure.add_gridspec(2, 2, width_ratios=(2.4, 1.0), height_ratios=(1.5, 1.0),
-                               left=0.07, right=0.98, bottom=0.1, top=0.86,
-                               hspace=0.1, wspace=0.3)
-    signals = figure.add_subplot(grid[0, 0], gid=gids[0])
-    errors = figure.add_subplot(grid[1, 0], sharex=signals, gid=gids[1])
-    theory = figure.add_subplot(grid[:, 1], gid=gids[2])
-    times = scenario.times
-    panels = (signals, errors)
-    handles = []
-    for gid, (panel, role, label) in _LINES.items():
-        extra = {"linewidth": 1.0} if panel == 1 else {}
-        (line,) = panels[panel].plot(times, np.zeros_like(times),
-                                     **style(role, gid=gid, label=label, **extra))
-        if label is not None:
-            handles.append(line)
-    figure.legend(handles=handles, loc="upper left", bbox_to_anchor=(0.07, 0.945), ncol=3,
-                  fontsize=8)
+class _Panels(NamedTuple):
+    """The artists :func:`draw_noisier_proprioception` builds and fills on every call."""
 
-    limit = 1.4 * scenario.amplitude
-    signals.set_ylim(-limit, limit)
-    signals.set_ylabel("position (cm)")
-    signals.tick_params(labelbottom=False)
-    errors.axhline(0.0, **style("truth", linewidth=0.8))
-    errors.set_ylim(-2.5, 2.5)
-    errors.set_xlim(0.0, scenario.duration)
-    errors.set_xlabel("time (s)")
-    errors.set_ylabel("error (cm)")
-    figure.align_ylabels((signals, errors))
+    trial: TrialPanels
+    marker: Line2D
 
+
+def _build(figure: Figure, scenario: Scenario) -> _Panels:
+    """Build the three panels of :func:`draw_noisier_proprioception` on the empty ``figure``."""
+    trial = build_trial_panels(figure, scenario, _LINES, width_ratios=(2.4, 1.0),
+                               height_ratios=(1.5, 1.0), top=0.86, wspace=0.3,
+                               signal_limit=1.4 * scenario.amplitude, error_limit=2.5)
+    figure.legend(handles=legend_handles(trial, _LINES), loc="upper left",
+                  bbox_to_anchor=(0.07, 0.945), ncol=3, fontsize=8)
+
+    theory = trial.side
     curve_sigma = np.geomspace(*CURVE_RANGE, 120)
     level, curve = steady_position_variances(scenario, scenario.sigma_v, curve_sigma)
     theory.axhline(level, **style("alternative", gid="theory vision-only",
                                   label="vision only"))
     theory.plot(curve_sigma, curve, **style("estimate", gid="theory fused", label="fused"))
-    theory.plot([], [], gid="theory now", linestyle="none", marker="o", markersize=7,
-                color=COLORS["estimate"], label="slider's σ_p")
+    (marker,) = theory.plot([], [], gid="theory now", linestyle="none", marker="o",
+                            markersize=7, color=COLORS["estimate"], label="slider's σ_p")
     theory.set_xscale("log")
     theory.set_xlim(*CURVE_RANGE)
     # Plain labels, as in the notebook's Figure 3 (mathtext powers of ten render slowly).
@@ -207,7 +182,7 @@ def _layout(figure: Figure, scenario: Scenario) -> tuple[Axes, Axes, Axes]:
     theory.set_ylabel("steady-state position variance (cm²)")
     theory.legend(loc="lower right", fontsize=8)
     pin_axis_labels(figure)
-    return signals, errors, theory
+    return _Panels(trial, marker)
 
 
 def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:

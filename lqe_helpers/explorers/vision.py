@@ -5,16 +5,16 @@ visual samples and the filter's estimate with the ±2σ band of its own position
 variance, for one fixed noise pattern scaled by σ_v.
 
 Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
-filter run, so :func:`draw_vision` builds the panel once per figure and afterwards
-only replaces the data, limits and title of the same artists. The picture is the
-same as a fresh drawing (a test checks the PNG bytes); only the redraw is faster.
+filter run, so :func:`draw_vision` builds the panel once per figure
+(:func:`~lqe_helpers.explorer.reuse_panels`) and afterwards only replaces the data,
+limits and title of the same artists. The picture is the same as a fresh drawing (a
+test checks the PNG bytes); only the redraw is faster.
 """
 
 from __future__ import annotations
 
-import weakref
-from dataclasses import dataclass
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 from matplotlib.axes import Axes
@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments, validation
-from ..explorer import Explorer, float_slider
+from ..explorer import Explorer, float_slider, reuse_panels
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -39,29 +39,17 @@ ESTIMATE_LABEL = "filtered estimate"
 BAND_LABEL = "±2σ of the filter's own variance"
 
 
-@dataclass(frozen=True)
-class _Panel:
-    """The artists :func:`draw_vision` built on one figure, reused by later calls."""
+class _Panel(NamedTuple):
+    """The artists :func:`draw_vision` builds on a figure and fills on every call."""
 
-    scenario: Scenario
     ax: Axes
     vision: Line2D
     band: FillBetweenPolyCollection
     estimate: Line2D
 
-    def belongs_to(self, figure: Figure, scenario: Scenario) -> bool:
-        """True if ``figure`` still shows exactly this panel, for ``scenario``."""
-        return (self.scenario == scenario and figure.axes == [self.ax]
-                and self.estimate in self.ax.lines and self.band in self.ax.collections)
-
-
-#: Panels already built, by figure (weak: a figure that is gone frees its entry).
-_PANELS: weakref.WeakKeyDictionary[Figure, _Panel] = weakref.WeakKeyDictionary()
-
 
 def _build(figure: Figure, scenario: Scenario) -> _Panel:
-    """Clear ``figure`` and build the artists, with no data yet."""
-    figure.clear()
+    """Build the artists on the empty ``figure``, with no data yet."""
     ax = figure.add_subplot()
     times = scenario.times
     vision, = ax.plot(times, np.zeros_like(times), label=VISION_LABEL, **style("vision"))
@@ -74,7 +62,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panel:
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4, fontsize=9,
               markerscale=3)
     figure.subplots_adjust(left=0.08, right=0.98, top=0.91, bottom=0.27)
-    return _Panel(scenario, ax, vision, band, estimate)
+    return _Panel(ax, vision, band, estimate)
 
 
 def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
@@ -113,9 +101,7 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
     raw_mse = float(tracking.measurement_mse("vision"))
     filtered_mse = float(tracking.mse())
 
-    panel = _PANELS.get(figure)
-    if panel is None or not panel.belongs_to(figure, scenario):
-        panel = _PANELS[figure] = _build(figure, scenario)
+    panel = reuse_panels(figure, _build, scenario)
     panel.vision.set_ydata(measured)
     panel.band.set_data(scenario.times, estimate - 2 * std, estimate + 2 * std)
     panel.estimate.set_ydata(estimate)
