@@ -5,8 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lqe_helpers import model
+from lqe_helpers import model, prediction
 from lqe_helpers.prediction import predict_ahead, propagate_covariance
+from lqe_helpers.scenario import DEFAULT
 
 
 def test_predict_ahead_applies_a_power_to_older_estimates() -> None:
@@ -72,3 +73,34 @@ def test_propagate_covariance_matches_hand_recursion_and_grows() -> None:
 def test_bad_input(call, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         call()
+
+
+def test_open_loop_follows_the_model() -> None:
+    estimate = np.array([1.0, -20.0, 50.0])
+    P = np.diag([0.5, 4.0, 100.0])
+    loop = prediction.open_loop(DEFAULT, estimate, P, 0.2)
+    assert loop.times.shape == (21,)
+    A = DEFAULT.A
+    np.testing.assert_allclose(loop.means[-1], np.linalg.matrix_power(A, 20) @ estimate)
+    # Constant acceleration from the start: p = p0 + v t + a t² / 2 exactly.
+    t = loop.times
+    np.testing.assert_allclose(loop.means[:, 0], 1.0 - 20.0 * t + 25.0 * t**2, atol=1e-12)
+    expected = P
+    for _ in range(20):
+        expected = A @ expected @ A.T + DEFAULT.Q
+    np.testing.assert_allclose(loop.covariances[-1], expected, rtol=1e-12)
+    assert np.all(np.diff(loop.position_stds) > 0)
+
+
+def test_open_loop_from_a_known_start_grows_as_t_to_five_halves() -> None:
+    loop = prediction.open_loop(DEFAULT, np.zeros(3), np.zeros((3, 3)), 1.0)
+    t, std = loop.times[50:], loop.position_stds[50:]
+    slope = np.polyfit(np.log(t), np.log(std), 1)[0]
+    assert slope == pytest.approx(2.5, abs=0.02)
+
+
+def test_bad_open_loop_input_is_rejected_by_name() -> None:
+    with pytest.raises(ValueError, match="estimate"):
+        prediction.open_loop(DEFAULT, np.zeros(2), np.eye(3), 1.0)
+    with pytest.raises(ValueError, match="duration"):
+        prediction.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.0)

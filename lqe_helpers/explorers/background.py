@@ -24,7 +24,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, Null
 from .. import experiments, model, validation
 from ..explorer import Explorer, log_slider, reuse_panels
 from ..plotting import COLORS, label_time_position, style
-from ..prediction import propagate_covariance
+from ..prediction import OpenLoop, amplitude_crossing, open_loop
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
 
@@ -44,62 +44,6 @@ TRUTH_LABEL = "true path"
 ESTIMATE_LABEL = "filtered estimate"
 
 
-@dataclasses.dataclass(frozen=True)
-class OpenLoop:
-    """Prediction with no measurements from a known estimate and covariance.
-
-    Attributes
-    ----------
-    times : ndarray, shape (steps + 1,)
-        Time since the last measurement (s).
-    means : ndarray, shape (steps + 1, 3)
-        ``A^k ẑ``: where the observer expects the butterfly (cm, cm/s, cm/s²).
-    covariances : ndarray, shape (steps + 1, 3, 3)
-        ``P(k)`` from ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)).
-    """
-
-    times: np.ndarray
-    means: np.ndarray
-    covariances: np.ndarray
-
-    @property
-    def position_stds(self) -> np.ndarray:
-        """Standard deviation of the predicted position (cm), shape (steps + 1,)."""
-        return np.sqrt(self.covariances[:, 0, 0])
-
-
-def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
-              duration: float) -> OpenLoop:
-    """Predict ``duration`` s ahead with no measurements (Tutorial eq. (1) without noise).
-
-    The mean follows the model, ``ẑ(k+1) = A ẑ(k)``; the covariance grows as
-    ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)), with the scenario's A and Q.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        Supplies Δt, A and Q (through its σ_j).
-    estimate : array_like, shape (3,)
-        Estimate ``[p, v, a]`` when the measurements stop.
-    covariance : array_like, shape (3, 3)
-        Its covariance, e.g. the filter's ``estimate_covariances`` at that time, or
-        zeros for a perfectly known start.
-    duration : float
-        Prediction horizon in s, > 0.
-    """
-    estimate = validation.finite_array("estimate", estimate, min_ndim=1)
-    if estimate.shape != (3,):
-        raise ValueError(f"estimate must have shape (3,), got shape {estimate.shape}")
-    duration = validation.positive("duration", duration, "s")
-    steps = round(duration / scenario.dt)
-    covariances = propagate_covariance(covariance, scenario.A, scenario.Q, steps)
-    means = np.empty((steps + 1, 3))
-    means[0] = estimate
-    for k in range(steps):
-        means[k + 1] = scenario.A @ means[k]
-    return OpenLoop(np.arange(steps + 1) * scenario.dt, means, covariances)
-
-
 def steady_estimate_covariance(scenario: Scenario) -> np.ndarray:
     """Covariance (3, 3) of the vision-only filter's estimate once it has settled.
 
@@ -114,15 +58,6 @@ def steady_estimate_covariance(scenario: Scenario) -> np.ndarray:
 def format_jerk(jerk_std: float) -> str:
     """σ_j as text: whole numbers from 100 cm/s³ up ("1,396"), 3 digits below ("31.6")."""
     return f"{jerk_std:,.0f}" if jerk_std >= 100 else f"{jerk_std:.3g}"
-
-
-def amplitude_crossing(loop: OpenLoop, amplitude: float) -> float | None:
-    """First time (s) at which 2σ of the predicted position reaches ``amplitude`` (cm).
-
-    None if it stays below within the prediction's horizon.
-    """
-    above = 2 * loop.position_stds >= amplitude
-    return float(loop.times[np.argmax(above)]) if above.any() else None
 
 
 def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
