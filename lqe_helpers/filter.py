@@ -45,7 +45,7 @@ class CovarianceSequence:
     estimate_covariances: np.ndarray
 
 
-def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
+def _covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
                         R: np.ndarray, P0: np.ndarray) -> CovarianceSequence:
     """Run the gain and covariance lines of Tutorial eq. (5) for ``n_steps`` steps.
 
@@ -62,9 +62,10 @@ def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarra
     * the gain follows from the updated covariance, ``K = P⁺ Cᵀ R⁻¹``, which equals
       ``P Cᵀ (C P Cᵀ + R)⁻¹``.
 
-    Once P stops changing (every entry within 10⁻¹⁴ of its relative value, the
+    Once one step leaves P unchanged (every entry within 10⁻¹⁴ relative: the
     Riccati fixed point to rounding) the remaining steps repeat the last gain
-    instead of re-rounding the same numbers.
+    instead of re-rounding the same numbers. The check runs every few steps and
+    always compares consecutive steps, so a covariance that cycles never passes.
 
     Inputs are assumed already validated by :func:`kalman_filter`; R (..., m, m) and
     P0 (..., k, k) may carry batch axes that broadcast against each other.
@@ -81,8 +82,8 @@ def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarra
     # np.dot skips matmul's broadcasting machinery, which dominates 3×3 products.
     mul = np.dot if P.ndim == 2 else np.matmul
     estimate_covariances, gains = [], []
-    previous = P
     for j in range(n_steps):
+        prior = P
         for row, row_T in rows:
             Pc = mul(P, row_T)
             g = Pc / (mul(row, Pc) + 1.0)
@@ -91,10 +92,12 @@ def covariance_sequence(n_steps: int, A: np.ndarray, C: np.ndarray, Q: np.ndarra
         estimate_covariances.append(P)
         gains.append(mul(P, ct_r_inv))
         P = mul(mul(A, P), A.T) + Q
-        if j % _CONVERGENCE_CHECK_EVERY == 0:
-            if np.allclose(P, previous, rtol=_CONVERGED_RTOL, atol=0.0):
-                break
-            previous = P
+        # P_{j+1} = f(P_j) for a fixed map f, so P_{j+1} = P_j means every later P is
+        # the same. (Comparing P with itself several steps back would not do: a
+        # covariance that cycles with that period would pass for converged.)
+        if j % _CONVERGENCE_CHECK_EVERY == 0 and np.allclose(P, prior, rtol=_CONVERGED_RTOL,
+                                                              atol=0.0):
+            break
     converged = len(gains)
     estimate_covariances = np.stack(estimate_covariances, axis=-3)
     gains = np.stack(gains, axis=-3)
@@ -136,7 +139,7 @@ def kalman_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
     in Q (Lesson 0.5 eq. (9)), so K and P are unchanged.
 
     Because K and P do not depend on the data they are computed once per distinct
-    (R, P0) by :func:`covariance_sequence`, and the estimates of every Monte Carlo
+    (R, P0) by :func:`_covariance_sequence`, and the estimates of every Monte Carlo
     run follow from ``ẑ ← (A − K C A) ẑ + K y_j`` in one vectorised pass.
 
     Parameters
@@ -216,7 +219,7 @@ def kalman_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
         y=y.shape[:-2], R=R.shape[:-2], z0=z0.shape[:-1], P0=P0.shape[:-2], u=input_batch
     )
 
-    sequence = covariance_sequence(n_steps, A, C, Q, R, P0)
+    sequence = _covariance_sequence(n_steps, A, C, Q, R, P0)
     gains = sequence.gains
     # ẑ_j = M_j ẑ_{j-1} + K_j y_j + (I − K_j C) B u_j with M_j = A − K_j C A:
     # Tutorial eq. (5) rearranged so that the data enter once, for all j together.

@@ -221,3 +221,29 @@ def test_converged_gain_shortcut_changes_nothing_measurable() -> None:
     est, gains, _, _ = filterpy_reference(y, A, C, Q, R, np.zeros(3), np.eye(3))
     np.testing.assert_allclose(ours.estimates, est, rtol=0, atol=1e-9)
     np.testing.assert_allclose(ours.gains, gains, rtol=1e-12, atol=0)
+
+
+@pytest.mark.parametrize("period", [3, 4, 8, 16])
+def test_a_cycling_covariance_is_not_taken_for_converged(period: int) -> None:
+    """An unobserved, noise-free mode rotating by 2π/period each step makes P cycle.
+
+    P then equals itself ``period`` steps back without ever settling; the filter
+    must keep computing it (checked against filterpy, step by step).
+    """
+    angle = 2 * np.pi / period
+    rotation = np.array([[np.cos(angle), -np.sin(angle)], [np.sin(angle), np.cos(angle)]])
+    A = np.eye(3)
+    A[1:, 1:] = rotation
+    C = np.array([[1.0, 0.0, 0.0]])
+    Q = np.diag([1.0, 0.0, 0.0])
+    R = np.array([[1.0]])
+    P0 = np.diag([1.0, 4.0, 1.0])
+    y = np.random.default_rng(period).normal(size=(200, 1))
+    ours = kalman_filter(y, A, C, Q, R, np.zeros(3), P0)
+    est, gains, covs, est_covs = filterpy_reference(y, A, C, Q, R, np.zeros(3), P0)
+    np.testing.assert_allclose(ours.estimate_covariances, est_covs, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(ours.covariances, covs, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(ours.gains, gains, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(ours.estimates, est, rtol=1e-9, atol=1e-9)
+    # The cycle is real: the unobserved variances swap between 4 and 1 (for period 4).
+    assert np.ptp(ours.estimate_covariances[-period:, 1, 1]) > 1.0
