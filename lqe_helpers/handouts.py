@@ -11,8 +11,12 @@
 Each notebook is executed once, in a fresh kernel, by
 :func:`lqe_helpers.notebook_runner.execute_notebook`. A notebook that raises, shows an
 error output, or displays a widget with no static view (which a page could only show
-as a placeholder) stops the build; output on stderr (a warning) is reported but
-kept. Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
+as a placeholder) stops the build, and the message names the notebook and the cell
+(and gives the traceback); output on stderr (a warning) is reported but kept. Only
+once every notebook has run is anything written: then every other ``*.html`` file
+directly in the output folder or its ``prose/`` folder (the page of a notebook since
+renamed or removed) is deleted, so the folders hold exactly the current pages.
+Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
 
 - every figure embedded as a base64 ``data:`` URI (outputs and markdown images);
 - the widget-view mimetype left out of the display priority, so an explorer shows
@@ -40,14 +44,15 @@ from pathlib import Path
 
 import nbformat
 from jinja2 import DictLoader
-from nbclient.exceptions import CellExecutionError
+from nbclient.exceptions import CellTimeoutError, DeadKernelError
 from nbconvert.exporters import HTMLExporter
+from nbconvert.filters import strip_ansi
 from nbconvert.preprocessors import Preprocessor
 from traitlets import List, Unicode
 from traitlets.config import Config
 
-from lqe_helpers.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook
-from lqe_helpers.student_edition import check_out_dir, source_notebooks
+from lqe_helpers.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook, fail
+from lqe_helpers.student_edition import check_out_dir, remove_stale, source_notebooks
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"
@@ -201,13 +206,29 @@ def notebook_title(notebook: nbformat.NotebookNode, fallback: str) -> str:
 
 
 def error_outputs(notebook: nbformat.NotebookNode) -> list[str]:
-    """Where ``notebook`` shows an error: ``"cell N: Name: message"`` per error output."""
+    """Where ``notebook`` shows an error: ``"cell N: Name: message"`` per error output.
+
+    ``N`` counts every cell (markdown included) from 0.
+    """
     found = []
     for index, cell in enumerate(notebook.cells):
         for output in cell.get("outputs", []):
             if output.get("output_type") == "error":
                 found.append(f"cell {index}: {output.get('ename')}: {output.get('evalue')}")
     return found
+
+
+def error_tracebacks(notebook: nbformat.NotebookNode) -> list[str]:
+    """The traceback of each error output, as plain text headed ``"cell N:"``.
+
+    In the order of :func:`error_outputs`, without the terminal colour codes.
+    """
+    return [
+        f"cell {index}:\n" + strip_ansi("\n".join(output.get("traceback", []))).strip()
+        for index, cell in enumerate(notebook.cells)
+        for output in cell.get("outputs", [])
+        if output.get("output_type") == "error"
+    ]
 
 
 def unshowable_widgets(notebook: nbformat.NotebookNode) -> list[str]:
@@ -296,17 +317,19 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
 def _execute(path: Path) -> nbformat.NotebookNode:
     """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
 
-    Warns (:class:`HandoutWarning`) if a cell printed to stderr.
+    Every cell runs even after one raises, so the message can name each cell that
+    shows an error (the first is usually the cause; later ones may follow from it)
+    and give the first traceback. Warns (:class:`HandoutWarning`) if a cell printed
+    to stderr.
     """
     try:
-        notebook = execute_notebook(path)
-    except CellExecutionError as error:
-        raise HandoutBuildError(
-            f"{path}: a cell raised {error.ename}: {error.evalue} (traceback above)"
-        ) from error
+        notebook = execute_notebook(path, allow_errors=True)
+    except (CellTimeoutError, DeadKernelError) as error:
+        raise HandoutBuildError(f"{path}: {error}") from error
     errors = error_outputs(notebook)
     if errors:
-        raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}")
+        raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}\n"
+                                f"Traceback of the first, {error_tracebacks(notebook)[0]}")
     widgets = unshowable_widgets(notebook)
     if widgets:
         raise HandoutBuildError(
@@ -330,7 +353,10 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
         Folder of the source notebooks (``*.ipynb``, in name order; read only).
     out_dir : Path
         Output folder (created if needed). Receives ``NN_name.html`` per notebook and
-        ``index.html``; ``out_dir/prose/`` receives the same without code cells.
+        ``index.html``; ``out_dir/prose/`` receives the same without code cells. Once
+        every notebook has run, any other ``*.html`` file directly in either folder
+        (left by an earlier build) is deleted; nothing else there is touched. A
+        notebook that stops the build stops it before anything is written or deleted.
     mathjax_url : str
         Where the pages load MathJax from (asynchronously); ``""`` leaves it out.
 
@@ -355,8 +381,10 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
 
     written = []
+    names = {page.href for page in pages} | {"index.html"}
     for code, folder in ((True, out_dir), (False, out_dir / PROSE_DIR)):
         folder.mkdir(parents=True, exist_ok=True)
+        remove_stale(folder, "*.html", keep=names)
         exporter = handout_exporter(code=code, mathjax_url=mathjax_url,
                                     stems=[page.stem for page in pages])
         for number, ((path, notebook), page) in enumerate(zip(executed, pages, strict=True)):
@@ -387,17 +415,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--source", type=Path, default=Path("notebooks"),
                         help="folder of the source notebooks (default: notebooks)")
     parser.add_argument("--out", type=Path, default=Path("build/handouts"),
-                        help="output folder (default: build/handouts)")
+                        help="output folder (default: build/handouts); any other .html file "
+                             f"directly in it or in its {PROSE_DIR}/ folder is deleted")
     parser.add_argument("--mathjax-url", default=DEFAULT_MATHJAX_URL,
                         help="where pages load MathJax from; '' for none (LaTeX shown as text)")
     args = parser.parse_args(argv)
     try:
         written = build_handouts(args.source, args.out, mathjax_url=args.mathjax_url)
-    except ValueError as error:
-        parser.error(str(error))
-    except HandoutBuildError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 1
+    except (ValueError, HandoutBuildError) as error:
+        return fail(error)
     for path in written:
         print(path)
     return 0

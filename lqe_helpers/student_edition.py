@@ -21,7 +21,9 @@ whole pack):
 
 Every output and execution count is cleared, and notebook metadata other than the
 kernel and language (widget state included) is dropped. The source notebooks are
-only read, never written.
+only read, never written. Any other ``*.ipynb`` file directly in the output folder
+(the edition of a notebook since renamed or removed) is deleted, so the folder holds
+exactly the current edition; nothing else there is touched.
 
 A source notebook with no ``solution`` cell stops the build: its student edition
 would hand out every worked answer as it stands. ``--allow-without-solutions``
@@ -34,7 +36,7 @@ import argparse
 import copy
 import sys
 import warnings
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -46,6 +48,8 @@ from nbconvert.preprocessors import (
     Preprocessor,
 )
 from traitlets import Unicode
+
+from lqe_helpers.notebook_runner import fail
 
 #: Tag of a code cell holding a worked solution (source notebooks).
 SOLUTION_TAG = "solution"
@@ -269,6 +273,37 @@ def check_out_dir(source_dir: Path, out_dir: Path) -> None:
         raise ValueError(f"out_dir must differ from source_dir, got {out_dir} for both")
 
 
+def remove_stale(folder: Path, pattern: str, keep: Collection[str] = ()) -> list[Path]:
+    """Delete the files directly in ``folder`` that match ``pattern``, except ``keep``.
+
+    Used by the builds to clear what an earlier build wrote (the page or notebook
+    of a notebook since renamed) before they write. Only files (and symbolic links)
+    matching ``pattern`` go; sub-folders and every other file stay.
+
+    Parameters
+    ----------
+    folder : Path
+        The output folder; nothing happens if it does not exist.
+    pattern : str
+        Glob pattern of the files the build writes there (``"*.html"``).
+    keep : collection of str
+        Names of files to leave in place (the ones about to be overwritten anyway).
+
+    Returns
+    -------
+    list of Path
+        The deleted files, in name order.
+    """
+    folder = Path(folder)
+    if not folder.is_dir():
+        return []
+    stale = [path for path in sorted(folder.glob(pattern))
+             if (path.is_file() or path.is_symlink()) and path.name not in keep]
+    for path in stale:
+        path.unlink()
+    return stale
+
+
 def count_solutions(notebook: nbformat.NotebookNode) -> int:
     """How many cells of ``notebook`` are tagged ``solution``."""
     return sum(SOLUTION_TAG in _tags(cell) for cell in notebook.cells)
@@ -335,7 +370,9 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
     """Write the student edition of every notebook in ``source_dir`` to ``out_dir``.
 
     Every notebook is checked before anything is written, so a refused build
-    leaves ``out_dir`` as it was.
+    leaves ``out_dir`` as it was. Otherwise every ``*.ipynb`` file directly in
+    ``out_dir`` that is not written by this build (left by an earlier build of a
+    notebook since renamed or removed) is deleted; other files are left alone.
 
     Parameters
     ----------
@@ -370,6 +407,7 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
                             allow_without_solutions=allow_without_solutions)
         editions.append((out_dir / path.name, student_edition(notebook, path.stem)))
     out_dir.mkdir(parents=True, exist_ok=True)
+    remove_stale(out_dir, "*.ipynb", keep={target.name for target, _ in editions})
     for target, text in editions:
         target.write_text(text, encoding="utf-8")
     return [target for target, _ in editions]
@@ -381,7 +419,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--source", type=Path, default=Path("notebooks"),
                         help="folder of the source notebooks (default: notebooks)")
     parser.add_argument("--out", type=Path, default=Path("build/student"),
-                        help="folder for the student notebooks (default: build/student)")
+                        help="folder for the student notebooks (default: build/student); "
+                             "any other .ipynb file directly in it is deleted")
     parser.add_argument("--allow-without-solutions", action="store_true",
                         help="build notebooks that have no 'solution' cell (with a warning) "
                              "instead of refusing")
@@ -390,8 +429,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         written = build_student_edition(args.source, args.out,
                                         allow_without_solutions=args.allow_without_solutions)
     except ValueError as error:
-        print(f"error: {error}", file=sys.stderr)
-        return 1
+        return fail(error)
     for path in written:
         print(path)
     return 0

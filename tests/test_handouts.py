@@ -343,12 +343,30 @@ def test_without_mathjax_there_is_no_script_at_all(tmp_path):
                                                     f"$${MATH_DISPLAY}$$": 1}))
 
 
-def test_a_notebook_that_raises_stops_the_build(tmp_path):
-    write_fixture(tmp_path / "src", "03_broken", [new_code_cell("1 / 0")])
-    expected = r"03_broken\.ipynb: a cell raised ZeroDivisionError"
-    with pytest.raises(handouts.HandoutBuildError, match=expected):
-        handouts.build_handouts(tmp_path / "src", tmp_path / "out")
-    assert not (tmp_path / "out").exists()
+BROKEN = [new_markdown_cell("# Broken"), new_code_cell("x = 1"),
+          new_code_cell("def ratio():\n    return x / 0\n\n\nratio()"),
+          new_code_cell("print('after the error')")]
+
+
+def test_a_notebook_that_raises_stops_the_build_naming_the_cell(tmp_path):
+    write_fixture(tmp_path / "src", "03_broken", BROKEN)
+    out = tmp_path / "out"
+    (out / "prose").mkdir(parents=True)
+    (out / "01_old.html").write_text("old page")
+    (out / "prose" / "01_old.html").write_text("old page")
+    before = sorted(out.rglob("*"))
+    with pytest.raises(handouts.HandoutBuildError) as error:
+        handouts.build_handouts(tmp_path / "src", out)
+    message = str(error.value)
+    assert ("03_broken.ipynb shows error output(s): cell 2: ZeroDivisionError: division by zero"
+            in message)
+    # The traceback, as plain text, down to the line that raised.
+    traceback = message.split("Traceback of the first, cell 2:\n", 1)[1]
+    assert "ZeroDivisionError" in traceback
+    assert "ratio()" in traceback
+    assert re.search(r"-+> 2\s+return x / 0", traceback), traceback
+    assert "\x1b[" not in message
+    assert sorted(out.rglob("*")) == before, "a failed build must write and delete nothing"
 
 
 def test_an_allowed_error_still_stops_the_build(tmp_path):
@@ -380,6 +398,23 @@ def test_bad_folders_are_refused(tmp_path):
         handouts.build_handouts(tmp_path / "src", tmp_path / "src")
 
 
+def test_stale_pages_are_removed_and_nothing_else(tmp_path):
+    write_fixture(tmp_path / "src", cells=CELLS[:1])
+    out = tmp_path / "out"
+    stale = [out / "00_renamed.html", out / "prose" / "00_renamed.html"]
+    kept = [out / "notes.txt", out / "prose" / "style.css", out / "extra" / "page.html",
+            out / "prose" / "extra" / "page.html", out / "00_renamed.ipynb"]
+    for path in [*stale, *kept]:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("from before")
+    written = handouts.build_handouts(tmp_path / "src", out, mathjax_url="")
+    assert [path.relative_to(out).as_posix() for path in written] == [
+        "01_fixture.html", "index.html", "prose/01_fixture.html", "prose/index.html"]
+    assert not any(path.exists() for path in stale)
+    assert all(path.read_text() == "from before" for path in kept)
+    assert sorted(path for path in out.rglob("*") if path.is_file()) == sorted([*written, *kept])
+
+
 def test_command_line(tmp_path, capsys):
     write_fixture(tmp_path / "src", cells=CELLS[:1])
     out = tmp_path / "out"
@@ -388,9 +423,19 @@ def test_command_line(tmp_path, capsys):
     assert capsys.readouterr().out.split() == [
         str(out / name) for name in ("01_fixture.html", "index.html", "prose/01_fixture.html",
                                      "prose/index.html")]
-    write_fixture(tmp_path / "src", "02_broken", [new_code_cell("1 / 0")])
+    write_fixture(tmp_path / "src", "02_broken", BROKEN)
     assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(out)]) == 1
-    assert "02_broken.ipynb: a cell raised ZeroDivisionError" in capsys.readouterr().err
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith(f"error: {tmp_path / 'src' / '02_broken.ipynb'} shows error "
+                                   "output(s): cell 2: ZeroDivisionError")
+    assert "return x / 0" in captured.err
+    # Bad input: the same exit code and one "error:" line, no usage message.
+    assert handouts.main(["--source", str(tmp_path / "missing"), "--out", str(out)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (f"error: source_dir must be an existing folder, got "
+                            f"{tmp_path / 'missing'}\n")
 
 
 def test_exporter_never_picks_the_widget_view():

@@ -277,6 +277,29 @@ def test_bad_folders_are_refused(tmp_path):
         se.build_student_edition(tmp_path / "src", tmp_path / "src" / ".." / "src")
 
 
+def test_stale_notebooks_are_removed_and_nothing_else(tmp_path):
+    write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
+    out = tmp_path / "out"
+    stale = out / "00_renamed.ipynb"
+    kept = [out / "notes.md", out / "00_renamed.html", out / "extra" / "old.ipynb"]
+    for path in [stale, *kept]:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text("from before")
+
+    # A refused build deletes nothing either.
+    write(fixture_notebook(with_solutions=False), tmp_path / "src" / "02_untagged.ipynb")
+    with pytest.raises(se.MissingSolutionsError):
+        se.build_student_edition(tmp_path / "src", out)
+    assert stale.read_text() == "from before"
+
+    (tmp_path / "src" / "02_untagged.ipynb").unlink()
+    written = se.build_student_edition(tmp_path / "src", out)
+    assert written == [out / "01_fixture.ipynb"]
+    assert not stale.exists()
+    assert all(path.read_text() == "from before" for path in kept)
+    assert sorted(path for path in out.rglob("*") if path.is_file()) == sorted([*written, *kept])
+
+
 def test_command_line(tmp_path, capsys):
     source = write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
     out = tmp_path / "out"
@@ -292,6 +315,12 @@ def test_command_line(tmp_path, capsys):
         assert se.main(["--source", str(source.parent), "--out", str(out),
                         "--allow-without-solutions"]) == 0
     assert len(capsys.readouterr().out.split()) == 2
+    # Bad input: exit code 1 and one "error:" line, as for the handouts.
+    assert se.main(["--source", str(tmp_path / "missing"), "--out", str(out)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (f"error: source_dir must be an existing folder, got "
+                            f"{tmp_path / 'missing'}\n")
 
 
 # ------------------------------------------- every notebook, executed once a session

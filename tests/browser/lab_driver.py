@@ -245,29 +245,41 @@ class LabServer:
                     raise
 
     def stop(self) -> None:
-        """Stop the server and its kernels: politely, then by force. Idempotent."""
+        """Stop the server and its kernels: politely, then by force. Idempotent.
+
+        Whatever goes wrong on the polite path (the API refuses or answers something
+        other than JSON, the server does not exit in time, the wait is interrupted),
+        the server and its kernels are killed before this returns.
+        """
         try:
             if self.process.poll() is None:
                 try:
                     self.shutdown_kernels()
                     self.api("POST", "/api/shutdown", timeout=5.0)
-                except (OSError, urllib.error.URLError):
+                except Exception:  # any failure of the polite path: fall back to a signal
                     self.process.terminate()
                 try:
                     self.process.wait(timeout=SERVER_STOP_S)
                 except subprocess.TimeoutExpired:
-                    # Kernels run in their own sessions: end them by id, then the server.
-                    for pid in _child_pids(self.process.pid):
-                        try:
-                            os.kill(pid, signal.SIGKILL)
-                        except ProcessLookupError:
-                            pass
-                    self.process.kill()
-                    self.process.wait(timeout=SERVER_STOP_S)
+                    pass  # killed below
         finally:
-            if self._log_file is not None:
-                self._log_file.close()
-                self._log_file = None
+            try:
+                if self.process.poll() is None:
+                    self._kill()
+            finally:
+                if self._log_file is not None:
+                    self._log_file.close()
+                    self._log_file = None
+
+    def _kill(self) -> None:
+        """SIGKILL the server's kernels (in their own sessions, so by id), then the server."""
+        for pid in _child_pids(self.process.pid):
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except ProcessLookupError:
+                pass
+        self.process.kill()
+        self.process.wait(timeout=SERVER_STOP_S)
 
     def log_tail(self, lines: int = MAX_LOG_LINES) -> str:
         """The last ``lines`` lines of the server's (and its kernels') output."""

@@ -2,8 +2,9 @@
 
 The handouts are built afresh from ``notebooks/`` (with code, and the prose variant)
 and each page is opened from disk in Chromium with no network. Every image must load,
-nothing but a script (MathJax, which the pages load asynchronously and can do
-without) may try to reach the network, and every link to a local page must exist.
+nothing but the MathJax script the pages are built with (loaded asynchronously; the
+pages can do without it) may try to reach the network, and every link to a local
+page must exist.
 """
 
 from __future__ import annotations
@@ -14,16 +15,16 @@ import pytest
 from lab_driver import NOTEBOOK_DIR, course_notebooks, screenshot_path
 from offline_pages import OfflinePage, open_offline
 
+from lqe_helpers.handouts import DEFAULT_MATHJAX_URL, build_handouts
+
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
 
 
 @pytest.fixture(scope="session")
 def handout_pages(chromium_executable: str, tmp_path_factory: pytest.TempPathFactory
                   ) -> list[Path]:
-    from lqe_helpers.handouts import build_handouts
-
     out_dir = tmp_path_factory.mktemp("handouts")
-    written = build_handouts(NOTEBOOK_DIR, out_dir)
+    written = build_handouts(NOTEBOOK_DIR, out_dir, mathjax_url=DEFAULT_MATHJAX_URL)
     found = sorted(out_dir.rglob("*.html"))
     assert sorted(written) == found, "build_handouts did not list every page it wrote"
     return found
@@ -50,7 +51,8 @@ def test_every_handout_image_loads_offline(browser, handout_pages: list[Path]) -
     for page in pages:
         if page.path.stem in stems:
             assert page.images, f"{page.path.relative_to(root)} shows no image at all"
-        remote = [request for request in page.blocked if not request.startswith("script ")]
-        assert not remote, f"{page.path.relative_to(root)} needs the network for: {remote}"
+        # The one request that may leave the machine: the MathJax script, nothing else.
+        assert set(page.blocked) == {f"script {DEFAULT_MATHJAX_URL}"}, (
+            f"{page.path.relative_to(root)} tries the network for: {page.blocked}")
         missing = [str(link) for link in page.local_links if not link.is_file()]
         assert not missing, f"{page.path.relative_to(root)} links to missing pages: {missing}"
