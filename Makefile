@@ -5,8 +5,8 @@
 PYTHON ?= python3
 VENV ?= .venv
 BIN := $(VENV)/bin
-# Exact versions CI tested (Python 3.11). Run `make CONSTRAINTS= test` to install
-# from the lower bounds in pyproject.toml instead (e.g. on another Python).
+# Exact versions CI tested (Python 3.11; they need 3.11 or newer). Run `make CONSTRAINTS= test`
+# to ignore them and install the newest versions pyproject.toml's ranges allow (e.g. on 3.10).
 CONSTRAINTS ?= constraints.txt
 CONSTRAINT_FLAG := $(if $(CONSTRAINTS),-c $(CONSTRAINTS),)
 STAMP := $(VENV)/.installed

@@ -127,7 +127,7 @@ def true_states(scenario: Scenario, bias: float) -> np.ndarray:
     bias : float
         The constant true bias b of the acceleration signal in cm/s² (any sign).
     """
-    bias = _finite_number("bias", bias, "cm/s²")
+    bias = validation.finite_number("bias", bias, "cm/s²")
     states = scenario.truth[:, :3].copy()
     states[:, 2] = bias
     return states
@@ -135,7 +135,7 @@ def true_states(scenario: Scenario, bias: float) -> np.ndarray:
 
 def initial_state(scenario: Scenario, bias: float) -> np.ndarray:
     """True state ``[p, v, b]`` at ``t = −Δt``, the time ``z0`` refers to, shape (3,)."""
-    bias = _finite_number("bias", bias, "cm/s²")
+    bias = validation.finite_number("bias", bias, "cm/s²")
     p, v, _ = simulation.sinusoid_states(np.array([-scenario.dt]), scenario.amplitude,
                                          scenario.frequency)[0]
     return np.array([p, v, bias])
@@ -217,7 +217,7 @@ def dead_reckoning(readings: np.ndarray, start: np.ndarray, dt: float,
         raise ValueError(
             f"start must have trailing length 2 [p, v] or 3 [p, v, b], got shape {start.shape}"
         )
-    bias_estimate = _finite_number("bias_estimate", bias_estimate, "cm/s²")
+    bias_estimate = validation.finite_number("bias_estimate", bias_estimate, "cm/s²")
     F = transition_matrix(dt)
     G = input_matrix(dt)[:, 0]
     batch = validation.broadcast_batches(readings=readings.shape[:-1], start=start.shape[:-1])
@@ -242,7 +242,7 @@ def bias_drift(scenario: Scenario, bias: float) -> np.ndarray:
     ``t = −Δt``). The discrete integration of :func:`dead_reckoning` gives exactly
     this value at every sample.
     """
-    bias = _finite_number("bias", bias, "cm/s²")
+    bias = validation.finite_number("bias", bias, "cm/s²")
     elapsed = scenario.times + scenario.dt
     return bias * elapsed**2 / 2.0
 
@@ -384,25 +384,22 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
     InputTracking
         Leading axis: runs, if any.
     """
-    bias = _finite_number("bias", bias, "cm/s²")
+    bias = validation.finite_number("bias", bias, "cm/s²")
     sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
     sigma_v = validation.positive(
         "sigma_v", scenario.sigma_v if sigma_v is None else sigma_v, "cm")
     bias_prior_std = validation.positive("bias_prior_std", bias_prior_std, "cm/s²")
     if noise is None:
         noise = unit_noise(scenario, runs)
-    noise = validation.finite_array("noise", noise, min_ndim=2)
     expected = (scenario.n_steps, 2) if runs is None else (runs, scenario.n_steps, 2)
-    if noise.shape != expected:
-        raise ValueError(f"noise must have shape {expected}, got shape {noise.shape}")
+    noise = validation.shaped_array("noise", noise, expected, ", ".join(NOISE_COLUMNS))
 
     dt = scenario.dt
     truth = true_states(scenario, bias)
     readings = acceleration_readings(step_accelerations(scenario), bias, sigma_a,
                                      noise[..., 1])
     measurements = simulation.measure(truth[:, 0], noise[..., :1], np.array([sigma_v]))
-    speed = scenario.amplitude * 2.0 * np.pi * scenario.frequency
-    P0 = np.diag([scenario.amplitude**2, speed**2, bias_prior_std**2])
+    P0 = np.diag([scenario.amplitude**2, scenario.peak_speed**2, bias_prior_std**2])
     result = kalman_filter(
         measurements, transition_matrix(dt), model.observation_matrix(("vision",)),
         process_noise_covariance(dt, sigma_a), model.measurement_noise_covariance([sigma_v]),
@@ -411,14 +408,3 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
     drift = dead_reckoning(readings, initial_state(scenario, bias), dt)
     return InputTracking(scenario, bias, sigma_a, sigma_v, truth, readings, measurements,
                          result, drift)
-
-
-def _finite_number(name: str, value: float, unit: str) -> float:
-    """``value`` as a float if it is a finite number (any sign), else ``ValueError``."""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number in {unit}, got {value!r}") from None
-    if not np.isfinite(number):
-        raise ValueError(f"{name} must be a finite number in {unit}, got {value!r}")
-    return number

@@ -73,12 +73,13 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
     sensors : sequence of str
         ``("vision",)`` or ``("vision", "proprioception")``.
     sigmas : array_like, shape (..., m), optional
-        True noise σ of each sensor (cm). Default: the scenario's σ_v and σ_p.
+        True noise σ of each sensor (cm), > 0. Default: the scenario's σ_v and σ_p.
         Leading axes sweep σ in one call.
     assumed_sigmas : array_like, shape (..., m), optional
-        The σ the filter believes in, used for R (cm). Default: ``sigmas``.
+        The σ the filter believes in, used for R (cm), > 0. Default: ``sigmas``.
     p0_variance : float or array_like, shape (...), optional
-        P0 = p0_variance · I. Default: the scenario's. An array sweeps P0.
+        P0 = p0_variance · I (cm², cm²/s², cm²/s⁴), > 0. Default: the scenario's. An
+        array sweeps P0.
     runs : int, optional
         Monte Carlo runs; None for the single run shown in figures (run 0).
     noise : array_like, shape (n, m) or (runs, n, m), optional
@@ -96,26 +97,25 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
     defaults = {"vision": scenario.sigma_v, "proprioception": scenario.sigma_p}
     if sigmas is None:
         sigmas = [defaults[s] for s in sensors]
-    sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
-    assumed = sigmas if assumed_sigmas is None else validation.finite_array(
-        "assumed_sigmas", assumed_sigmas, min_ndim=1)
+    sigmas = validation.positive_array("sigmas", sigmas, "cm", min_ndim=1)
+    assumed = sigmas if assumed_sigmas is None else validation.positive_array(
+        "assumed_sigmas", assumed_sigmas, "cm", min_ndim=1)
     for name, value in (("sigmas", sigmas), ("assumed_sigmas", assumed)):
         if value.shape[-1] != len(sensors):
             raise ValueError(
                 f"{name} must have one σ per sensor {sensors} on its last axis, "
                 f"got shape {value.shape}"
             )
-    p0 = np.asarray(scenario.p0_variance if p0_variance is None else p0_variance, float)
+    p0 = validation.positive_array(
+        "p0_variance", scenario.p0_variance if p0_variance is None else p0_variance, "cm²")
     sweep = validation.broadcast_batches(
         sigmas=sigmas.shape[:-1], assumed_sigmas=assumed.shape[:-1], p0_variance=p0.shape
     )
     if noise is None:
         noise = scenario.unit_noise(runs, sensors)
-    noise = validation.finite_array("noise", noise, min_ndim=2)
     expected = (scenario.n_steps, len(sensors)) if runs is None else (
         runs, scenario.n_steps, len(sensors))
-    if noise.shape != expected:
-        raise ValueError(f"noise must have shape {expected}, got shape {noise.shape}")
+    noise = validation.shaped_array("noise", noise, expected, ", ".join(sensors))
     noise = noise.reshape(noise.shape[:-2] + (1,) * len(sweep) + noise.shape[-2:])
     y = simulation.measure(scenario.truth[:, 0], noise, sigmas)
     result = kalman_filter(

@@ -35,7 +35,8 @@ def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.n
     Parameters
     ----------
     estimate : array_like, shape (..., n)
-        Estimated positions (cm); leading axes are runs or a parameter sweep.
+        Estimated positions (cm); leading axes are runs or a parameter sweep. NaN is
+        allowed within the burn-in (e.g. a prediction that does not exist yet).
     truth : array_like, shape (n,)
         True positions (cm).
     burn_in_steps : int
@@ -52,8 +53,10 @@ def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.n
         If shapes differ on n, or NaN remains after the burn-in (e.g. a prediction
         that does not exist yet: raise the burn-in to at least the delay).
     """
-    estimate = np.asarray(estimate, dtype=float)
+    estimate = validation.numeric_array("estimate", estimate)
     truth = validation.finite_array("truth", truth, min_ndim=1)
+    if truth.ndim != 1:
+        raise ValueError(f"truth must have shape (n,), got shape {truth.shape}")
     if estimate.ndim < 1 or estimate.shape[-1] != truth.shape[-1]:
         raise ValueError(
             f"estimate must have shape (..., n) with n = {truth.shape[-1]} like truth, "

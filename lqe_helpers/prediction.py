@@ -123,13 +123,13 @@ def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
         Its covariance, e.g. the filter's ``estimate_covariances`` at that time, or
         zeros for a perfectly known start.
     duration : float
-        Prediction horizon in s, > 0.
+        Prediction horizon in s, > 0 and a whole number of the scenario's time steps.
     """
     estimate = validation.finite_array("estimate", estimate, min_ndim=1)
     if estimate.shape != (3,):
         raise ValueError(f"estimate must have shape (3,), got shape {estimate.shape}")
     duration = validation.positive("duration", duration, "s")
-    steps = round(duration / scenario.dt)
+    steps = validation.whole_steps("duration", duration, scenario.dt)
     covariances = propagate_covariance(covariance, scenario.A, scenario.Q, steps)
     means = np.empty((steps + 1, 3))
     means[0] = estimate
@@ -141,7 +141,21 @@ def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
 def amplitude_crossing(loop: OpenLoop, amplitude: float) -> float | None:
     """First time (s) at which 2σ of the predicted position reaches ``amplitude`` (cm).
 
-    None if it stays below within the prediction's horizon.
+    Parameters
+    ----------
+    loop : OpenLoop
+        A prediction from :func:`open_loop`.
+    amplitude : float
+        Threshold in cm, > 0 (e.g. the path's amplitude A).
+
+    Returns
+    -------
+    float or None
+        The time in s since the last measurement, or None if 2σ stays below
+        ``amplitude`` within the prediction's horizon.
     """
+    if not isinstance(loop, OpenLoop):
+        raise ValueError(f"loop must be an OpenLoop from open_loop(), got {type(loop).__name__}")
+    amplitude = validation.positive("amplitude", amplitude, "cm")
     above = 2 * loop.position_stds >= amplitude
     return float(loop.times[np.argmax(above)]) if above.any() else None

@@ -57,7 +57,8 @@ class Scenario:
     #: Time step Δt (s). 100 Hz: fast next to the 0.5 Hz flight, and the tutorial's
     #: 0.1 s sensory delay is then exactly δ = 10 steps.
     dt: float = 0.01
-    #: Length of a simulated trial (s): five periods of the flight, 1 000 steps.
+    #: Length of a simulated trial (s): five periods of the flight, 1 000 steps. Must be
+    #: a whole number of time steps, as must :attr:`burn_in` and :attr:`delay`.
     duration: float = 10.0
     #: Amplitude A of the butterfly's sinusoidal path (cm): a hand-sized movement,
     #: large next to the 1.5–4.5 cm sensor noise of the questions.
@@ -91,6 +92,7 @@ class Scenario:
     def __post_init__(self) -> None:
         validation.positive("dt", self.dt, "s")
         validation.positive("duration", self.duration, "s")
+        validation.whole_steps("duration", self.duration, self.dt)
         if self.duration < 2 * self.dt:
             raise ValueError(
                 f"duration must be at least two time steps ({2 * self.dt} s), got {self.duration}"
@@ -114,6 +116,7 @@ class Scenario:
         validation.count("seed", self.seed, minimum=0)
         validation.count("mc_runs", self.mc_runs, minimum=2)
         validation.non_negative("burn_in", self.burn_in, "s")
+        validation.whole_steps("burn_in", self.burn_in, self.dt)
         if self.burn_in >= self.duration:
             raise ValueError(
                 f"burn_in must be shorter than duration = {self.duration} s, got {self.burn_in}"
@@ -122,8 +125,8 @@ class Scenario:
     # Time -----------------------------------------------------------------------------
     @property
     def n_steps(self) -> int:
-        """Number of samples in a trial."""
-        return round(self.duration / self.dt)
+        """Number of samples in a trial: :attr:`duration` / :attr:`dt`, a whole number."""
+        return validation.whole_steps("duration", self.duration, self.dt)
 
     @property
     def times(self) -> np.ndarray:
@@ -132,8 +135,8 @@ class Scenario:
 
     @property
     def burn_in_steps(self) -> int:
-        """:attr:`burn_in` in samples."""
-        return round(self.burn_in / self.dt)
+        """:attr:`burn_in` in samples, a whole number."""
+        return validation.whole_steps("burn_in", self.burn_in, self.dt)
 
     def delay_steps(self, delay: float) -> int:
         """A delay in s as a whole number of samples δ = d / Δt.
@@ -142,16 +145,18 @@ class Scenario:
         whole multiple of :attr:`dt`.
         """
         delay = validation.non_negative("delay", delay, "s")
-        steps = round(delay / self.dt)
-        if abs(steps * self.dt - delay) > 1e-9 * max(1.0, delay):
-            raise ValueError(
-                f"delay must be a whole number of time steps dt = {self.dt} s, got {delay} s"
-            )
+        steps = validation.whole_steps("delay", delay, self.dt)
         if steps >= self.n_steps:
             raise ValueError(
                 f"delay must be shorter than the trial ({self.duration} s), got {delay} s"
             )
         return steps
+
+    # Path -----------------------------------------------------------------------------
+    @property
+    def peak_speed(self) -> float:
+        """Peak speed ``A · 2π f`` (cm/s) of the butterfly's path ``A sin(2π f t)``."""
+        return float(self.amplitude * 2.0 * np.pi * self.frequency)
 
     # Model ----------------------------------------------------------------------------
     @property

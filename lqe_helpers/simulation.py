@@ -110,8 +110,8 @@ def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
     Parameters
     ----------
     signal : array_like
-        Any array with time along ``axis``: measurements (..., n, m), estimates
-        (..., n, k), or a position trace (n,) with ``axis=-1``.
+        Any numeric array with time along ``axis``: measurements (..., n, m), estimates
+        (..., n, k), or a position trace (n,) with ``axis=-1``. NaN is passed through.
     steps : int
         Delay δ in samples, 0 <= δ <= n − 1.
     axis : int
@@ -122,9 +122,9 @@ def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
     ndarray
         Same shape as ``signal``; the first δ samples are NaN (nothing has arrived).
     """
-    signal = np.asarray(signal, dtype=float)
+    signal = validation.numeric_array("signal", signal)
     if signal.ndim == 0:
-        raise ValueError(f"signal must have a time axis, got a scalar {signal!r}")
+        raise ValueError(f"signal must have a time axis, got a scalar {signal.item()!r}")
     try:
         n_steps = signal.shape[axis]
     except IndexError:
@@ -146,6 +146,23 @@ def simulate_model_states(rng: np.random.Generator, A: np.ndarray, Q: np.ndarray
     ``z_0 ~ N(A·mean0, P0)`` and ``z_j = A z_{j−1} + ω``, ``ω ~ N(0, Q)``: exactly the
     statistics Tutorial eq. (5) assumes when it starts from ``ẑ = mean0, P = P0``.
 
+    Parameters
+    ----------
+    rng : numpy.random.Generator
+        Source of randomness, e.g. ``np.random.default_rng(seed)``.
+    A : array_like, shape (k, k)
+        Transition matrix.
+    Q : array_like, shape (k, k)
+        Process noise covariance, symmetric positive semidefinite.
+    mean0 : array_like, shape (k,)
+        Mean of the state one step before sample 0.
+    P0 : array_like, shape (k, k)
+        Covariance of the state at sample 0, symmetric positive semidefinite.
+    n_steps : int
+        Number of samples n, >= 1.
+    runs : int
+        Number of independent runs, >= 1.
+
     Returns
     -------
     ndarray, shape (runs, n, k)
@@ -153,16 +170,25 @@ def simulate_model_states(rng: np.random.Generator, A: np.ndarray, Q: np.ndarray
     if not isinstance(rng, np.random.Generator):
         raise ValueError(f"rng must be a numpy.random.Generator, got {rng!r}")
     A = validation.square_matrix("A", A)
+    if A.ndim != 2:
+        raise ValueError(f"A must have shape (k, k), got shape {A.shape}")
     k = A.shape[-1]
     Q = validation.covariance("Q", Q, size=k)
+    if Q.ndim != 2:
+        raise ValueError(f"Q must have shape ({k}, {k}), got shape {Q.shape}")
     P0 = validation.covariance("P0", P0, size=k)
+    if P0.ndim != 2:
+        raise ValueError(f"P0 must have shape ({k}, {k}), got shape {P0.shape}")
     mean0 = validation.finite_array("mean0", mean0, min_ndim=1)
+    if mean0.shape != (k,):
+        raise ValueError(f"mean0 must have shape ({k},) like A, got shape {mean0.shape}")
     n_steps = validation.count("n_steps", n_steps, minimum=1)
     runs = validation.count("runs", runs, minimum=1)
     first = rng.multivariate_normal(A @ mean0, P0, size=runs, method="eigh")
-    kicks = rng.multivariate_normal(np.zeros(k), Q, size=(runs, n_steps), method="eigh")
+    # One kick per transition: n − 1 of them, into samples 1 … n − 1.
+    kicks = rng.multivariate_normal(np.zeros(k), Q, size=(runs, n_steps - 1), method="eigh")
     states = np.empty((runs, n_steps, k))
     states[:, 0] = first
     for j in range(1, n_steps):
-        states[:, j] = states[:, j - 1] @ A.T + kicks[:, j]
+        states[:, j] = states[:, j - 1] @ A.T + kicks[:, j - 1]
     return states

@@ -64,8 +64,9 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
     Raises
     ------
     ValueError
-        If the inputs are invalid, or no finite fixed point is reached (C cannot see
-        an unstable mode of A, or Q does not drive it).
+        If the inputs are invalid; if P overflows, so no finite fixed point exists (C
+        cannot see an unstable mode of A, or Q does not drive it); or if
+        ``max_doublings`` steps end before the relative change of P falls to ``rtol``.
     """
     A = validation.square_matrix("A", A)
     if A.ndim != 2:
@@ -87,7 +88,8 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
     A_i = np.broadcast_to(A.T, (*batch, k, k))
     G_i = C.T @ np.linalg.solve(R, np.broadcast_to(C, (*batch, m, k)))
     H_i = np.broadcast_to(Q, (*batch, k, k))
-    for _ in range(max_doublings):
+    change = np.inf
+    for doubling in range(1, max_doublings + 1):
         # Without a fixed point H grows without bound: overflow is detected just below.
         with np.errstate(over="ignore", invalid="ignore"):
             W = np.linalg.inv(identity + G_i @ H_i)
@@ -96,7 +98,11 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
             H_next = H_i + A_i.mT @ H_i @ W @ A_i
             H_next = 0.5 * (H_next + H_next.mT)
         if not np.all(np.isfinite(H_next)):
-            break
+            raise ValueError(
+                f"the Riccati recursion has no finite fixed point for these A, C, Q and R "
+                f"(P overflowed at doubling step {doubling}): C must observe, and Q must "
+                f"drive, every mode of A that does not decay"
+            )
         change = np.max(np.abs(H_next - H_i)) / max(np.max(np.abs(H_next)), 1e-300)
         A_i, G_i, H_i = A_next, 0.5 * (G_next + G_next.mT), H_next
         if change <= rtol:
@@ -106,6 +112,7 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
             estimate = P - gain @ C @ P
             return SteadyState(P, gain, 0.5 * (estimate + estimate.mT))
     raise ValueError(
-        "the Riccati recursion has no finite fixed point for these A, C, Q and R: "
-        "C must observe, and Q must drive, every mode of A that does not decay"
+        f"max_doublings = {max_doublings} was too few to reach rtol = {rtol:g}: the last "
+        f"relative change of P was {change:.3g}; allow more doubling steps (the default "
+        f"is 200) or a larger rtol"
     )

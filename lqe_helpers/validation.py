@@ -54,8 +54,40 @@ def count(name: str, value: int, minimum: int = 0, maximum: int | None = None) -
     return int(value)
 
 
-def finite_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
-    """Return ``value`` as a float array with at least ``min_ndim`` axes and no NaN/inf."""
+def finite_number(name: str, value: float, unit: str = "") -> float:
+    """Return ``value`` as a float if it is a finite number of any sign, else raise."""
+    unit_text = f" in {unit}" if unit else ""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a finite number{unit_text}, got {value!r}") from None
+    if not np.isfinite(number):
+        raise ValueError(f"{name} must be a finite number{unit_text}, got {value!r}")
+    return number
+
+
+def whole_steps(name: str, value: float, dt: float) -> int:
+    """A time ``value`` (s) as a whole number of time steps ``dt`` (s).
+
+    ``value / dt`` must be a whole number up to floating-point rounding (a relative
+    tolerance of 1e-9), so that ``0.1 / 0.01`` counts as 10 steps but ``0.004 / 0.01``
+    is refused rather than silently rounded to 0 steps. Callers check the sign of
+    ``value`` themselves; ``dt`` must be > 0.
+    """
+    value = finite_number(name, value, "s")
+    dt = positive("dt", dt, "s")
+    ratio = value / dt
+    steps = round(ratio)
+    if abs(ratio - steps) > 1e-9 * max(1.0, abs(ratio)):
+        raise ValueError(
+            f"{name} must be a whole number of time steps dt = {dt} s, got {value} s "
+            f"({ratio:.6g} steps)"
+        )
+    return steps
+
+
+def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
+    """Return ``value`` as a float array with at least ``min_ndim`` axes; NaN/inf allowed."""
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -64,11 +96,46 @@ def finite_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
         raise ValueError(
             f"{name} must have at least {min_ndim} axes, got shape {array.shape}"
         )
+    return array
+
+
+def finite_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
+    """Return ``value`` as a float array with at least ``min_ndim`` axes and no NaN/inf."""
+    array = numeric_array(name, value, min_ndim)
     if not np.all(np.isfinite(array)):
         bad = int(np.size(array) - np.count_nonzero(np.isfinite(array)))
         raise ValueError(
             f"{name} must contain only finite numbers, got {bad} NaN or infinite "
             f"value(s) in {_describe(array)}"
+        )
+    return array
+
+
+def positive_array(name: str, value: object, unit: str = "", min_ndim: int = 0) -> np.ndarray:
+    """Return ``value`` as a finite float array whose entries are all > 0."""
+    array = finite_array(name, value, min_ndim)
+    if np.any(array <= 0):
+        unit_text = f" {unit}" if unit else ""
+        smallest = "" if array.size <= 4 else f" whose smallest entry is {array.min():g}"
+        every = "must be" if array.ndim == 0 else "must all be"
+        raise ValueError(
+            f"{name} {every} > 0{unit_text}, got {_describe(array)}{smallest}"
+        )
+    return array
+
+
+def shaped_array(name: str, value: object, shape: tuple[int, ...],
+                 columns: str = "") -> np.ndarray:
+    """Return ``value`` as a finite float array of exactly ``shape``.
+
+    ``columns`` names what the last axis holds, e.g. ``"vision, proprioception"``,
+    and is quoted in the error message.
+    """
+    array = finite_array(name, value)
+    if array.shape != tuple(shape):
+        what = f" ({columns})" if columns else ""
+        raise ValueError(
+            f"{name} must have shape {tuple(shape)}{what}, got shape {array.shape}"
         )
     return array
 
@@ -121,11 +188,6 @@ def covariance(name: str, value: object, size: int | None = None,
             f"eigenvalue of {smallest:.3g} times its largest entry"
         )
     return array
-
-
-def batch_shape(name: str, array: np.ndarray, core_ndim: int) -> tuple[int, ...]:
-    """Leading (batch) axes of ``array`` once its ``core_ndim`` trailing axes are removed."""
-    return array.shape[: array.ndim - core_ndim]
 
 
 def broadcast_batches(**shapes: tuple[int, ...]) -> tuple[int, ...]:

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import dataclasses
+import re
 
 import numpy as np
 import pytest
 
 from lqe_helpers import bias_model, experiments, metrics, simulation
+from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT
 
 DEFAULT_BIAS = bias_model.DEFAULT_BIAS
@@ -206,6 +208,38 @@ def test_sigma_v_defaults_to_the_scenario() -> None:
     np.testing.assert_allclose(
         tracking.measurements[:, 0] - scenario.truth[:, 0],
         4.5 * bias_model.unit_noise(scenario)[:, 0])
+
+
+def test_prior_spans_the_path_and_its_peak_speed() -> None:
+    """P0 = diag(A², (A·2πf)², bias_prior_std²), for a path other than the default."""
+    scenario = dataclasses.replace(DEFAULT, amplitude=4.0, frequency=1.5)
+    tracking = bias_model.track_with_input(scenario, bias_prior_std=30.0)
+    P0 = np.diag([16.0, (4.0 * 2 * np.pi * 1.5) ** 2, 900.0])
+    direct = kalman_filter(
+        tracking.measurements, bias_model.transition_matrix(scenario.dt),
+        np.array([[1.0, 0.0, 0.0]]), bias_model.process_noise_covariance(scenario.dt, 20.0),
+        np.array([[scenario.sigma_v**2]]), np.zeros(3), P0,
+        B=bias_model.input_matrix(scenario.dt), u=tracking.readings[:, None])
+    np.testing.assert_allclose(tracking.result.estimate_covariances,
+                               direct.estimate_covariances, rtol=1e-12)
+    np.testing.assert_allclose(tracking.result.estimates, direct.estimates, rtol=1e-12,
+                               atol=1e-12)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [(lambda: bias_model.true_states(DEFAULT, np.nan),
+      "bias must be a finite number in cm/s², got nan"),
+     (lambda: bias_model.initial_state(DEFAULT, "x"),
+      "bias must be a finite number in cm/s², got 'x'"),
+     (lambda: bias_model.track_with_input(DEFAULT, noise=np.zeros((10, 2))),
+      "noise must have shape (1000, 2) (vision, acceleration), got shape (10, 2)"),
+     (lambda: bias_model.track_with_input(DEFAULT, runs=2, noise=bias_model.unit_noise(DEFAULT)),
+      "noise must have shape (2, 1000, 2) (vision, acceleration), got shape (1000, 2)")],
+)
+def test_bad_input_messages(call, message: str) -> None:
+    with pytest.raises(ValueError, match=re.escape(message)):
+        call()
 
 
 @pytest.mark.parametrize(

@@ -79,11 +79,37 @@ def test_delay_and_compensate_shifts_and_predicts() -> None:
             lambda: experiments.track(DEFAULT, sensors=FUSED, assumed_sigmas=[1.5]),
             "assumed_sigmas must have one σ per sensor",
         ),
-        (lambda: experiments.track(DEFAULT, sigmas=[-1.5]), "sigmas must all be > 0 cm"),
-        (lambda: experiments.track(DEFAULT, p0_variance=-1.0), "variance must be > 0"),
+        (
+            lambda: experiments.track(DEFAULT, sigmas=[-1.5]),
+            r"sigmas must all be > 0 cm, got \[-1.5\]",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, sensors=FUSED, assumed_sigmas=[1.5, -1.0]),
+            r"assumed_sigmas must all be > 0 cm, got \[1.5, -1.0\]",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, sigmas=[[1.5], [1.5], [0.0], [1.5], [1.5]]),
+            r"sigmas must all be > 0 cm, got an array of shape \(5, 1\) whose smallest entry is 0",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, p0_variance=-1.0),
+            "p0_variance must be > 0 cm², got -1.0",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, p0_variance=[1.0, np.nan]),
+            "p0_variance must contain only finite numbers",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, p0_variance="large"),
+            "p0_variance must be a numeric array, got 'large'",
+        ),
         (
             lambda: experiments.track(DEFAULT, runs=3, noise=np.zeros((2, 1000, 1))),
-            r"noise must have shape \(3, 1000, 1\)",
+            r"noise must have shape \(3, 1000, 1\) \(vision\), got shape \(2, 1000, 1\)",
+        ),
+        (
+            lambda: experiments.track(DEFAULT, sensors=FUSED, noise=np.zeros(1000)),
+            r"noise must have shape \(1000, 2\) \(vision, proprioception\), got shape \(1000,\)",
         ),
         (lambda: experiments.track(DEFAULT, sensors=("smell",)), "sensors must be distinct names"),
         (

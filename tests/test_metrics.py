@@ -23,9 +23,12 @@ def test_mse_refuses_nan_after_burn_in() -> None:
     assert metrics.mse(estimate, np.zeros(4), burn_in_steps=2) == 1.0
 
 
-@pytest.mark.parametrize("df", [1, 2, 5, 10, 29, 30, 31, 50, 299, 10_000])
+@pytest.mark.parametrize("df", [*range(1, 31), 31, 50, 299, 10_000])
 def test_t_critical_matches_scipy(df: int) -> None:
-    assert metrics.t_critical_95(df) == pytest.approx(stats.t.ppf(0.975, df), abs=2e-4)
+    # The table holds 4 decimals (rounding error <= 5e-5); above it the docstring
+    # promises the expansion to 1e-5.
+    tolerance = 5e-5 if df <= 30 else 1e-5
+    assert metrics.t_critical_95(df) == pytest.approx(stats.t.ppf(0.975, df), abs=tolerance)
 
 
 def test_mean_ci95_matches_scipy_t_interval() -> None:
@@ -63,7 +66,7 @@ def test_convergence_time_interval_brackets_the_estimate() -> None:
     interval = metrics.convergence_time_ci95(errors, 0.01, np.random.default_rng(3))
     assert interval.low <= interval.mean <= interval.high
     # True curve: 40 e^{-t/30} + 1 crosses 2 at index 30 ln 40 ≈ 110.7 → 1.11 s.
-    assert interval.low < 1.11 < interval.high + 0.1
+    assert interval.low < 1.11 < interval.high
 
 
 @pytest.mark.parametrize(
@@ -90,6 +93,14 @@ def test_convergence_time_interval_brackets_the_estimate() -> None:
             "runs >= 2",
         ),
         (lambda: metrics.t_critical_95(0), "df must be a whole number >= 1, got 0"),
+        (
+            lambda: metrics.mse(["near", "far"], np.zeros(2)),
+            r"estimate must be a numeric array, got \['near', 'far'\]",
+        ),
+        (
+            lambda: metrics.mse(np.zeros(4), np.zeros((2, 4))),
+            r"truth must have shape \(n,\), got shape \(2, 4\)",
+        ),
     ],
 )
 def test_bad_input(call, message: str) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 
@@ -104,3 +106,36 @@ def test_bad_open_loop_input_is_rejected_by_name() -> None:
         prediction.open_loop(DEFAULT, np.zeros(2), np.eye(3), 1.0)
     with pytest.raises(ValueError, match="duration"):
         prediction.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.0)
+    # Less than a step, or between two steps: refused rather than rounded.
+    with pytest.raises(ValueError, match=r"duration must be a whole number of time steps "
+                                         r"dt = 0.01 s, got 0.004 s \(0.4 steps\)"):
+        prediction.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.004)
+    with pytest.raises(ValueError, match="duration must be a whole number of time steps"):
+        prediction.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.255)
+    # Whole steps up to floating-point rounding are accepted.
+    assert prediction.open_loop(DEFAULT, np.zeros(3), np.eye(3), 0.3).times.shape == (31,)
+
+
+def test_amplitude_crossing() -> None:
+    loop = prediction.open_loop(DEFAULT, np.zeros(3), np.zeros((3, 3)), 1.0)
+    crossing = prediction.amplitude_crossing(loop, 1.0)
+    first = int(np.argmax(2 * loop.position_stds >= 1.0))
+    assert crossing == pytest.approx(loop.times[first])
+    assert 2 * loop.position_stds[first - 1] < 1.0
+    assert prediction.amplitude_crossing(loop, 1e6) is None
+
+
+@pytest.mark.parametrize(
+    ("loop", "amplitude", "message"),
+    [
+        (None, 10.0, "loop must be an OpenLoop from open_loop(), got NoneType"),
+        ("open", -10.0, "amplitude must be a finite number > 0 cm, got -10.0"),
+        ("open", 0.0, "amplitude must be a finite number > 0 cm, got 0.0"),
+        ("open", "ten", "amplitude must be a number > 0 cm, got 'ten'"),
+    ],
+)
+def test_amplitude_crossing_bad_input(loop, amplitude, message: str) -> None:
+    if loop == "open":
+        loop = prediction.open_loop(DEFAULT, np.zeros(3), np.zeros((3, 3)), 0.5)
+    with pytest.raises(ValueError, match=re.escape(message)):
+        prediction.amplitude_crossing(loop, amplitude)

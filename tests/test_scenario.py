@@ -33,11 +33,39 @@ def test_truth_is_the_sinusoid() -> None:
     np.testing.assert_allclose(DEFAULT.truth[:, 0], 10 * np.sin(np.pi * DEFAULT.times))
 
 
+def test_peak_speed_is_the_largest_speed_of_the_path() -> None:
+    assert DEFAULT.peak_speed == pytest.approx(10.0 * np.pi)
+    assert DEFAULT.peak_speed == pytest.approx(np.max(np.abs(DEFAULT.truth[:, 1])))
+    assert replace(DEFAULT, amplitude=4.0, frequency=2.0).peak_speed == pytest.approx(16 * np.pi)
+
+
+@pytest.mark.parametrize(
+    "change",
+    [{}, {"duration": 0.3, "burn_in": 0.1, "delay": 0.1}, {"duration": 30.0},
+     {"dt": 0.001}, {"dt": 0.002, "duration": 0.7, "burn_in": 0.006, "delay": 0.014}],
+)
+def test_times_that_are_whole_steps_up_to_rounding_are_accepted(change: dict) -> None:
+    scenario = replace(DEFAULT, **change)
+    assert scenario.n_steps * scenario.dt == pytest.approx(scenario.duration)
+    assert scenario.burn_in_steps * scenario.dt == pytest.approx(scenario.burn_in)
+    assert scenario.delay_steps(scenario.delay) * scenario.dt == pytest.approx(scenario.delay)
+
+
 @pytest.mark.parametrize(
     ("change", "message"),
     [
         ({"dt": 0.0}, "dt must be a finite number > 0 s, got 0.0"),
         ({"duration": 0.01}, "duration must be at least two time steps"),
+        (
+            {"duration": 10.005},
+            r"duration must be a whole number of time steps dt = 0.01 s, got 10.005 s",
+        ),
+        ({"dt": 0.03}, "duration must be a whole number of time steps dt = 0.03 s, got 10.0 s"),
+        (
+            {"burn_in": 0.004},
+            r"burn_in must be a whole number of time steps dt = 0.01 s, got 0.004 s \(0.4 steps\)",
+        ),
+        ({"burn_in": "long"}, "burn_in must be a number >= 0 s, got 'long'"),
         ({"frequency": 60.0}, "frequency must be below the Nyquist limit"),
         ({"delay": 0.105}, "delay must be a whole number of time steps dt = 0.01 s, got 0.105 s"),
         ({"delay": -0.1}, "delay must be a finite number >= 0 s, got -0.1"),

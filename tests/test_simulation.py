@@ -70,6 +70,42 @@ def test_delay_signal_shifts_and_pads_with_nan() -> None:
         (lambda: simulation.delay_signal(np.zeros((5, 1)), 1.5), "steps must be a whole number"),
         (lambda: simulation.delay_signal(np.zeros(5), 1, axis=3), "axis must name an axis"),
         (
+            lambda: simulation.delay_signal(["a", "b"], 1, axis=-1),
+            r"signal must be a numeric array, got \['a', 'b'\]",
+        ),
+        (
+            lambda: simulation.delay_signal(2.0, 0),
+            "signal must have a time axis, got a scalar 2.0",
+        ),
+        (
+            lambda: simulation.simulate_model_states(
+                np.random.default_rng(0), np.eye(3)[None], np.eye(3), np.zeros(3), np.eye(3),
+                5, 2),
+            r"A must have shape \(k, k\), got shape \(1, 3, 3\)",
+        ),
+        (
+            lambda: simulation.simulate_model_states(
+                np.random.default_rng(0), np.eye(3), np.eye(3), np.zeros(2), np.eye(3), 5, 2),
+            r"mean0 must have shape \(3,\) like A, got shape \(2,\)",
+        ),
+        (
+            lambda: simulation.simulate_model_states(
+                np.random.default_rng(0), np.eye(3), np.eye(3)[None], np.zeros(3), np.eye(3),
+                5, 2),
+            r"Q must have shape \(3, 3\), got shape \(1, 3, 3\)",
+        ),
+        (
+            lambda: simulation.simulate_model_states(
+                np.random.default_rng(0), np.eye(3), np.eye(3), np.zeros(3), np.eye(3)[None],
+                5, 2),
+            r"P0 must have shape \(3, 3\), got shape \(1, 3, 3\)",
+        ),
+        (
+            lambda: simulation.simulate_model_states(
+                np.random.default_rng(0), np.eye(3), np.eye(3), np.zeros(3), np.eye(3), 0, 2),
+            "n_steps must be a whole number >= 1, got 0",
+        ),
+        (
             lambda: simulation.unit_noise(np.random.RandomState(0), 5, 1),
             "rng must be a numpy.random.Generator",
         ),
@@ -103,3 +139,28 @@ def test_scenario_noise_matches_between_single_run_and_monte_carlo() -> None:
     np.testing.assert_array_equal(batch[0], single)
     vision_only = DEFAULT.unit_noise(sensors=("vision",))
     np.testing.assert_array_equal(vision_only[:, 0], single[:, 0])
+
+
+def test_delay_signal_passes_nan_through() -> None:
+    out = simulation.delay_signal([np.nan, 1.0, 2.0], 1, axis=-1)
+    assert np.all(np.isnan(out[:2]))
+    assert out[2] == 1.0
+
+
+def test_model_states_follow_the_model() -> None:
+    A = np.array([[1.0, 0.1], [0.0, 1.0]])
+    mean0 = np.array([2.0, -1.0])
+    # No noise at all: the mean path A^(j+1) mean0 exactly.
+    quiet = simulation.simulate_model_states(np.random.default_rng(0), A, np.zeros((2, 2)),
+                                             mean0, np.zeros((2, 2)), 4, 3)
+    expected = [np.linalg.matrix_power(A, j + 1) @ mean0 for j in range(4)]
+    np.testing.assert_allclose(quiet, np.broadcast_to(expected, (3, 4, 2)), rtol=1e-14)
+    # One kick per transition, each with covariance Q; a single sample has none.
+    Q = np.array([[1.0, 0.3], [0.3, 0.5]])
+    states = simulation.simulate_model_states(np.random.default_rng(1), A, Q, mean0,
+                                              np.zeros((2, 2)), 3, 20_000)
+    kicks = states[:, 1:] - states[:, :-1] @ A.T
+    np.testing.assert_allclose(np.cov(kicks.reshape(-1, 2).T), Q, atol=0.03)
+    one = simulation.simulate_model_states(np.random.default_rng(1), A, Q, mean0, np.eye(2),
+                                           1, 5)
+    assert one.shape == (5, 1, 2)

@@ -54,8 +54,21 @@ def test_batched_r_gives_one_steady_state_each() -> None:
 
 def test_unobservable_unstable_mode_is_reported() -> None:
     A = np.diag([1.0, 1.1])  # the second state grows and nothing measures it
-    with pytest.raises(ValueError, match="no finite fixed point"):
+    with pytest.raises(ValueError, match=r"no finite fixed point .*\(P overflowed at doubling"):
         steady_state(A, [[1.0, 0.0]], np.eye(2), [[1.0]])
+
+
+def test_running_out_of_doublings_is_not_reported_as_no_fixed_point() -> None:
+    A = model.transition_matrix(0.01)
+    Q = model.process_noise_covariance(0.01, 1400.0)
+    C, R = model.observation_matrix(), model.measurement_noise_covariance([1.5])
+    with pytest.raises(ValueError, match=r"max_doublings = 2 was too few to reach "
+                                         r"rtol = 1e-13: the last relative change of P was "
+                                         r"\d") as error:
+        steady_state(A, C, Q, R, max_doublings=2)
+    assert "no finite fixed point" not in str(error.value)
+    # Enough doublings for the same problem converge.
+    assert np.all(np.isfinite(steady_state(A, C, Q, R, max_doublings=60).covariance))
 
 
 @pytest.mark.parametrize(
