@@ -6,12 +6,12 @@ import base64
 import dataclasses
 import gc
 import importlib
-import io
 import weakref
 from typing import NamedTuple
 
 import numpy as np
 import pytest
+from explorer_checks import png
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
@@ -49,6 +49,43 @@ def test_slider_conventions():
     assert (logarithmic.min, logarithmic.max, logarithmic.step) == (-2.0, 6.0, 0.25)
     assert logarithmic.value == pytest.approx(1.0)
     assert logarithmic.continuous_update is False
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [((50.0, 0.0, 10.0, 1.0), r"value must lie in .*\[0, 10\] .*'x \(cm\)', got 50"),
+     ((-0.5, 0.0, 10.0, 1.0), r"value must lie in .*\[0, 10\] .*got -0\.5"),
+     ((1.0, 10.0, 0.0, 1.0), r"low must be < high .*got low = 10, high = 0"),
+     ((1.0, 2.0, 2.0, 1.0), r"low must be < high .*got low = 2, high = 2"),
+     ((1.0, 0.0, 10.0, 0.0), r"step must be a finite number > 0, got 0"),
+     ((1.0, 0.0, 10.0, -0.5), r"step must be a finite number > 0, got -0\.5"),
+     ((float("nan"), 0.0, 10.0, 1.0), r"value must be a finite number, got nan"),
+     ((1.0, 0.0, float("inf"), 1.0), r"high must be a finite number, got inf")],
+)
+def test_float_slider_refuses_what_ipywidgets_would_clip_or_break(arguments, message):
+    with pytest.raises(ValueError, match=message):
+        float_slider("x (cm)", *arguments)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [((1.0, 0.0, 10.0), r"low must be > 0 .*'P0 \(cm²\)', got 0"),
+     ((1.0, -1.0, 10.0), r"low must be > 0 .*got -1"),
+     ((1e7, 1e-2, 1e6), r"value must lie in .*\[0\.01, 1000000\] .*got 10000000"),
+     ((1e-3, 1e-2, 1e6), r"value must lie in .*got 0\.001"),
+     ((1.0, 10.0, 1.0), r"low must be < high"),
+     ((1.0, 0.1, 10.0, 0), r"steps_per_decade must be a whole number >= 1, got 0"),
+     ((1.0, 0.1, 10.0, 2.5), r"steps_per_decade must be a whole number >= 1, got 2\.5")],
+)
+def test_log_slider_refuses_what_ipywidgets_would_clip_or_break(arguments, message):
+    with pytest.raises(ValueError, match=message):
+        log_slider("P0 (cm²)", *arguments)
+
+
+def test_slider_ends_are_valid_starting_values():
+    assert float_slider("x (cm)", 0.0, 0.0, 10.0, 1.0).value == 0.0
+    assert float_slider("x (cm)", 10.0, 0.0, 10.0, 1.0).value == 10.0
+    assert log_slider("P0 (cm²)", 1e6, 1e-2, 1e6).value == pytest.approx(1e6)
 
 
 @pytest.mark.parametrize("fmt", [",.0f", "_.1f"])
@@ -92,7 +129,29 @@ def test_static_fallback_shows_the_current_figure_and_a_note():
     assert base64.b64decode(bundle["image/png"]) == explorer.png
     html = bundle["text/html"]
     assert bundle["image/png"] in html
-    assert "JupyterLab" in html and "s (cm)" in html
+    assert "JupyterLab" in html
+    assert "shown at its default values: s (cm) = 1.00." in html
+
+
+def test_static_note_lists_the_values_shown_after_a_slider_moved():
+    explorer = make_explorer()
+    explorer.sliders["slope"].value = 4.5
+    html = explorer.static_html()
+    assert "default" not in html
+    assert "a test line, shown at s (cm) = 4.50." in html
+    assert base64.b64encode(explorer.png).decode("ascii") in html
+    # Back at the start: the default values again.
+    explorer.sliders["slope"].value = 1.0
+    assert "shown at its default values: s (cm) = 1.00." in explorer.static_html()
+
+
+def test_static_note_lists_every_slider_as_its_readout_shows_it():
+    sliders = {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5, readout_format=".1f"),
+               "variance": log_slider("P0 (cm²)", 100.0, 1.0, 1e4, readout_format=".3g")}
+    explorer = Explorer("two <sliders>", sliders, lambda figure, **_: draw_line(figure, slope=1),
+                        figsize=(4.0, 3.0), dpi=50)
+    html = explorer.static_html()
+    assert "two &lt;sliders&gt;, shown at its default values: s (cm) = 1.0; P0 (cm²) = 100." in html
 
 
 # reuse_panels: build a figure's panels once, refill them on later calls.
@@ -258,12 +317,6 @@ DRAWINGS = [
 ]
 
 
-def _png(figure: Figure) -> bytes:
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=40, metadata={"Software": None})
-    return buffer.getvalue()
-
-
 @pytest.mark.parametrize(("module", "name", "values"), DRAWINGS, ids=[d[0] for d in DRAWINGS])
 def test_every_explorer_keeps_its_panels_until_the_scenario_changes(module, name, values):
     draw = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), name)
@@ -277,5 +330,5 @@ def test_every_explorer_keeps_its_panels_until_the_scenario_changes(module, name
     assert not set(figure.axes) & set(axes)
     fresh = Figure(figsize=(10.0, 5.0))
     draw(fresh, scenario=other, **values)
-    assert _png(figure) == _png(fresh)
+    assert png(figure, dpi=40) == png(fresh, dpi=40)
 

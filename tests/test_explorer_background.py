@@ -3,25 +3,17 @@
 from __future__ import annotations
 
 import dataclasses
-import io
 import math
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
+from explorer_checks import line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, model
 from lqe_helpers.explorers import background
 from lqe_helpers.scenario import DEFAULT
 from lqe_helpers.steady_state import steady_state
-
-
-def line(ax: Axes, label: str) -> np.ndarray:
-    """y data of the one line labelled ``label``."""
-    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
-    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
-    return np.asarray(found[0].get_ydata(), float)
 
 
 def direct_growth(jerk_std: float, steps: int = 100) -> np.ndarray:
@@ -38,8 +30,9 @@ def direct_growth(jerk_std: float, steps: int = 100) -> np.ndarray:
     return 2 * np.sqrt(np.array(out))
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def explorer():
+    """A new explorer for every test, so no test sees another's slider moves."""
     return background.explore_background()
 
 
@@ -85,7 +78,6 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
 
 
 def test_title_gives_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
-    explorer.sliders["jerk_std"].value = DEFAULT.process_jerk_std
     growth = direct_growth(DEFAULT.process_jerk_std)
     first = int(np.argmax(growth >= DEFAULT.amplitude))
     assert first > 0
@@ -117,7 +109,6 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
     np.testing.assert_array_equal(visions[0], visions[1])
     np.testing.assert_array_equal(estimates[0], estimates[2])
     assert not np.array_equal(estimates[0], estimates[1])
-    explorer.sliders["jerk_std"].value = DEFAULT.process_jerk_std
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
@@ -150,12 +141,6 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_j (cm/s³)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
-
-
-def png(figure: Figure) -> bytes:
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
-    return buffer.getvalue()
 
 
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
@@ -194,3 +179,17 @@ def test_another_scenario_redraws_its_reference_curve() -> None:
                      model.measurement_noise_covariance([4.5])).estimate_covariance
     np.testing.assert_allclose(line(growth_ax, background.REFERENCE_LABEL)[0],
                                2 * np.sqrt(P[0, 0]), rtol=1e-12)
+
+
+def test_slider_starts_at_the_scenarios_jerk_std() -> None:
+    scenario = dataclasses.replace(DEFAULT, jerk_std=300.0)
+    slider = background.explore_background(scenario).sliders["jerk_std"]
+    assert slider.value == pytest.approx(300.0)
+
+
+@pytest.mark.parametrize("jerk_std", [5.0, 2.0e5])
+def test_scenario_outside_the_slider_range_is_refused(jerk_std: float) -> None:
+    """Not clipped into the range: the explorer would show another σ_j than asked for."""
+    scenario = dataclasses.replace(DEFAULT, jerk_std=jerk_std)
+    with pytest.raises(ValueError, match=r"scenario\.process_jerk_std .*\[10, 100000\] cm/s³"):
+        background.explore_background(scenario)

@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-import io
 import math
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
+from explorer_checks import band_matches, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import bias_model, model
@@ -17,20 +16,6 @@ from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT
 
 SHOWN = DEFAULT.times <= bias_explorer.WINDOW
-
-
-def line(ax: Axes, label: str) -> np.ndarray:
-    """y data of the one line labelled ``label``."""
-    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
-    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
-    return np.asarray(found[0].get_ydata(), float)
-
-
-def band_edges(ax: Axes, label: str) -> np.ndarray:
-    """Vertices (x, y) of the filled band labelled ``label``."""
-    found = [c for c in ax.collections if c.get_label() == label]
-    assert len(found) == 1, f"expected one band labelled {label!r}, got {len(found)}"
-    return np.concatenate([path.vertices for path in found[0].get_paths()])
 
 
 def direct_filter(bias: float, sigma_a: float, sigma_v: float, noise: np.ndarray):
@@ -46,8 +31,9 @@ def direct_filter(bias: float, sigma_a: float, sigma_v: float, noise: np.ndarray
                          np.array([[sigma_v**2]]), np.zeros(3), P0, B=G, u=readings[:, None])
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture
 def explorer():
+    """A new explorer for every test, so no test sees another's slider moves."""
     return bias_explorer.explore_bias()
 
 
@@ -85,12 +71,9 @@ def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
                                expected.estimates[SHOWN, 2], rtol=0, atol=1e-9)
     np.testing.assert_array_equal(line(bias_ax, bias_explorer.TRUE_BIAS_LABEL),
                                   values["bias"])
-    band = band_edges(bias_ax, bias_explorer.BIAS_BAND_LABEL)
     std = np.sqrt(expected.estimate_covariances[SHOWN, 2, 2])
-    index = np.rint(band[:, 0] / DEFAULT.dt).astype(int)
     centre = expected.estimates[SHOWN, 2]
-    np.testing.assert_allclose(np.abs(band[:, 1] - centre[index]), 2 * std[index],
-                               rtol=1e-9, atol=1e-9)
+    band_matches(bias_ax, bias_explorer.BIAS_BAND_LABEL, centre - 2 * std, centre + 2 * std)
     truth = DEFAULT.truth[SHOWN, 0]
     np.testing.assert_allclose(line(path_ax, bias_explorer.VISION_LABEL),
                                truth + values["sigma_v"] * noise[SHOWN, 0], atol=1e-12)
@@ -110,7 +93,6 @@ def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
 
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
     explorer.sliders["bias"].value = 20.0
-    explorer.sliders["sigma_v"].value = 1.5
     truth = DEFAULT.truth[SHOWN, 0]
     patterns, estimates = [], []
     for sigma_v in (1.0, 3.0, 1.0):
@@ -130,8 +112,6 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
         wander.append(line(explorer.figure.axes[1], bias_explorer.DEAD_RECKONING_LABEL)
                       - noise_free)
     np.testing.assert_allclose(wander[1], 4 * wander[0], rtol=1e-6, atol=1e-9)
-    explorer.sliders["sigma_v"].value = DEFAULT.sigma_v
-    explorer.sliders["sigma_a"].value = bias_model.DEFAULT_SIGMA_A
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
@@ -186,12 +166,6 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert explorer.png.startswith(b"\x89PNG")
 
 
-def png(figure: Figure) -> bytes:
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
-    return buffer.getvalue()
-
-
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(10, 4.6))
     for values in ({"bias": -55.0, "sigma_a": 300.0, "sigma_v": 4.5},
@@ -228,3 +202,16 @@ def test_another_scenario_rebuilds_the_panels() -> None:
     np.testing.assert_array_equal(line(path_ax, bias_explorer.TRUTH_LABEL),
                                   wider.truth[SHOWN, 0])
     assert path_ax.get_ylim() == (-30.0, 30.0)
+
+
+def test_sigma_v_slider_starts_at_the_scenarios() -> None:
+    scenario = dataclasses.replace(DEFAULT, sigma_v=4.5)
+    assert bias_explorer.explore_bias(scenario).sliders["sigma_v"].value == 4.5
+
+
+@pytest.mark.parametrize("sigma_v", [0.2, 7.5])
+def test_scenario_outside_the_slider_range_is_refused(sigma_v: float) -> None:
+    """Not clipped into the range: the explorer would show another σ_v than asked for."""
+    scenario = dataclasses.replace(DEFAULT, sigma_v=sigma_v)
+    with pytest.raises(ValueError, match=rf"scenario\.sigma_v .*\[0\.5, 6\] cm, got {sigma_v:g}"):
+        bias_explorer.explore_bias(scenario)

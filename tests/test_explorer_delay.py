@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 import pytest
-from matplotlib.backends.backend_agg import FigureCanvasAgg
+from explorer_checks import fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments
@@ -18,14 +18,11 @@ SHOWN = DEFAULT.times <= WINDOW
 
 
 def _lines(figure: Figure) -> dict[str, np.ndarray]:
-    """y data of every line with a gid, by gid (x data checked separately)."""
+    """y data of every line with a gid, by gid; every line runs over the shown window."""
     found = {}
-    for ax in figure.axes:
-        for line in ax.lines:
-            if line.get_gid() is not None:
-                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
-                np.testing.assert_array_equal(line.get_xdata(), DEFAULT.times[SHOWN])
-                found[line.get_gid()] = np.asarray(line.get_ydata(), float)
+    for gid, (x, y) in lines_by_gid(figure).items():
+        np.testing.assert_array_equal(x, DEFAULT.times[SHOWN], err_msg=gid)
+        found[gid] = y
     return found
 
 
@@ -160,8 +157,7 @@ def test_redraw_reuses_axes_and_keeps_one_band():
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise():
-    figure = Figure()
-    FigureCanvasAgg(figure)
+    figure = fresh_figure()
     noise = np.random.default_rng(11).standard_normal((DEFAULT.n_steps, 1))
     draw_delay(figure, delay=0.17, noise=noise)
     _check_figure(figure, 0.17, noise)
@@ -203,3 +199,10 @@ def test_static_display_shows_the_figure_and_names_the_slider():
     bundle = explore_delay()._repr_mimebundle_()
     assert "delay (s)" in bundle["text/html"]
     assert re.search(r'src="data:image/png;base64,[A-Za-z0-9+/=]{100,}"', bundle["text/html"])
+
+
+def test_scenario_delay_beyond_the_slider_range_is_refused():
+    """Not clipped to the slider's end: the explorer would show another delay than asked for."""
+    scenario = dataclasses.replace(DEFAULT, delay=0.6)
+    with pytest.raises(ValueError, match=r"scenario\.delay .*\[0, 0\.5\] s, got 0\.6 s"):
+        explore_delay(scenario)

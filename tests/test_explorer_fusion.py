@@ -6,7 +6,7 @@ import dataclasses
 
 import numpy as np
 import pytest
-from matplotlib.backends.backend_agg import FigureCanvasAgg
+from explorer_checks import fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 
 from lqe_helpers.explorers.fusion import (
@@ -23,21 +23,12 @@ LINE_GIDS = {"vision readings", "proprioception readings", "truth", "vision-only
              "vision-only error", "fused error"}
 
 
-def _fresh_figure() -> Figure:
-    figure = Figure(figsize=(10.0, 5.0))
-    FigureCanvasAgg(figure)
-    return figure
-
-
 def _lines(figure: Figure, scenario: Scenario = DEFAULT) -> dict[str, np.ndarray]:
     """y data of every line with a gid, by gid; every line runs over the whole trial."""
     found = {}
-    for ax in figure.axes:
-        for line in ax.lines:
-            if line.get_gid() is not None:
-                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
-                np.testing.assert_array_equal(line.get_xdata(), scenario.times)
-                found[line.get_gid()] = np.asarray(line.get_ydata(), float)
+    for gid, (x, y) in lines_by_gid(figure).items():
+        np.testing.assert_array_equal(x, scenario.times, err_msg=gid)
+        found[gid] = y
     return found
 
 
@@ -156,7 +147,7 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     assert len(axes) == 3
     bands = [c for c in axes[1].collections if c.get_gid() == "fused band"]
     assert len(bands) == 1
-    fresh = _fresh_figure()
+    fresh = fresh_figure()
     draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5)
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     for gid in LINE_GIDS:
@@ -166,7 +157,7 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
 
 
 def test_band_is_the_fused_filters_own_two_standard_deviations():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     draw_fusion(figure, sigma_v=1.5, sigma_p=3.0)
     (band,) = [c for c in figure.axes[1].collections if c.get_gid() == "fused band"]
     vertices = band.get_paths()[0].vertices
@@ -189,7 +180,7 @@ def _upper_edge(vertices: np.ndarray) -> np.ndarray:
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     noise = np.random.default_rng(7).standard_normal((DEFAULT.n_steps, 2))
     draw_fusion(figure, sigma_v=2.5, sigma_p=1.0, noise=noise)
     _check_figure(figure, 2.5, 1.0, noise)
@@ -198,7 +189,7 @@ def test_draw_function_on_a_fresh_figure_with_given_noise():
 
 
 def test_draw_function_clears_a_foreign_figure():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     figure.subplots(2, 2)
     draw_fusion(figure, sigma_v=1.5, sigma_p=4.5)
     assert len(figure.axes) == 3
@@ -217,12 +208,12 @@ def test_explorer_follows_its_scenario():
                           (1.5, float("nan"), "sigma_p"), (1.5, 0.0, "sigma_p")])
 def test_bad_sigma_raises(sigma_v, sigma_p, name):
     with pytest.raises(ValueError, match=name):
-        draw_fusion(_fresh_figure(), sigma_v=sigma_v, sigma_p=sigma_p)
+        draw_fusion(fresh_figure(), sigma_v=sigma_v, sigma_p=sigma_p)
 
 
 def test_bad_noise_raises():
     with pytest.raises(ValueError, match="noise must have shape"):
-        draw_fusion(_fresh_figure(), sigma_v=1.5, sigma_p=1.5,
+        draw_fusion(fresh_figure(), sigma_v=1.5, sigma_p=1.5,
                     noise=np.zeros((DEFAULT.n_steps, 1)))
 
 
@@ -251,3 +242,11 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
     for description in ("σ_v (cm)", "σ_p (cm)"):
         assert description in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+
+
+@pytest.mark.parametrize(("field", "value"), [("sigma_v", 0.25), ("sigma_p", 7.0)])
+def test_scenario_outside_the_slider_range_is_refused(field: str, value: float) -> None:
+    """Not clipped into the range: the explorer would show another σ than asked for."""
+    scenario = dataclasses.replace(DEFAULT, **{field: value})
+    with pytest.raises(ValueError, match=rf"scenario\.{field} .*\[0\.5, 6\] cm, got {value:g}"):
+        explore_fusion(scenario)

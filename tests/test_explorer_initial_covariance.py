@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import io
+import dataclasses
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
+from explorer_checks import band_matches, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, metrics
@@ -16,28 +16,9 @@ from lqe_helpers.scenario import DEFAULT
 SHOWN = round(ic.WINDOW / DEFAULT.dt) + 1
 
 
-def line(ax: Axes, label: str) -> np.ndarray:
-    """y data of the one line labelled ``label``."""
-    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
-    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
-    return np.asarray(found[0].get_ydata(), float)
-
-
-def band_matches(ax: Axes, low: np.ndarray, high: np.ndarray) -> None:
-    """The filled band of ``ax`` has its edges at ``low`` and ``high``."""
-    found = [c for c in ax.collections if c.get_label() == ic.BAND_LABEL]
-    assert len(found) == 1
-    vertices = np.concatenate([path.vertices for path in found[0].get_paths()])
-    index = np.rint(vertices[:, 0] / DEFAULT.dt).astype(int)
-    scale = max(1.0, float(np.max(np.abs(high))))
-    on_edge = (np.isclose(vertices[:, 1], low[index], rtol=0, atol=1e-9 * scale)
-               | np.isclose(vertices[:, 1], high[index], rtol=0, atol=1e-9 * scale))
-    assert on_edge.all()
-    assert np.unique(index).size == low.size
-
-
-@pytest.fixture(scope="module")
+@pytest.fixture
 def explorer():
+    """A new explorer for every test, so no test sees another's slider moves."""
     return ic.explore_initial_covariance()
 
 
@@ -75,7 +56,8 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance)
         np.testing.assert_allclose(line(ax, ic.ESTIMATE_LABEL), estimates[:, column],
                                    rtol=1e-12, atol=1e-9)
         std = np.sqrt(variances[:, column, column])
-        band_matches(ax, estimates[:, column] - 2 * std, estimates[:, column] + 2 * std)
+        band_matches(ax, ic.BAND_LABEL, estimates[:, column] - 2 * std,
+                     estimates[:, column] + 2 * std)
 
     title = explorer.figure.get_suptitle()
     burn = DEFAULT.burn_in_steps
@@ -96,7 +78,6 @@ def test_first_step_follows_tutorial_gain_formula(explorer) -> None:
         assert line(position_ax, ic.ESTIMATE_LABEL)[0] == pytest.approx(gain * y0)
         # A diagonal P0 gives velocity no gain at the first sample.
         assert line(velocity_ax, ic.ESTIMATE_LABEL)[0] == pytest.approx(0.0, abs=1e-12)
-    explorer.sliders["p0_variance"].value = DEFAULT.p0_variance
 
 
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
@@ -106,7 +87,6 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
         seen.append(line(explorer.figure.axes[0], ic.VISION_LABEL))
     np.testing.assert_array_equal(seen[0], seen[1])
     np.testing.assert_array_equal(seen[0], seen[2])
-    explorer.sliders["p0_variance"].value = DEFAULT.p0_variance
 
 
 def test_steady_state_part_does_not_depend_on_p0() -> None:
@@ -146,12 +126,6 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert explorer.png.startswith(b"\x89PNG")
 
 
-def png(figure: Figure) -> bytes:
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
-    return buffer.getvalue()
-
-
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(9, 4))
     for p0_variance in (1e6, 1e-2, 31.6):
@@ -172,3 +146,17 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     ic.draw_initial_covariance(figure, p0_variance=1e3)
     assert len(figure.axes) == 2
     assert figure.get_suptitle().startswith("P0 = 1e+03")
+
+
+def test_slider_starts_at_the_scenarios_p0_variance() -> None:
+    scenario = dataclasses.replace(DEFAULT, p0_variance=1e5)
+    slider = ic.explore_initial_covariance(scenario).sliders["p0_variance"]
+    assert slider.value == pytest.approx(1e5)
+
+
+@pytest.mark.parametrize("p0_variance", [1e-3, 1e7])
+def test_scenario_outside_the_slider_range_is_refused(p0_variance: float) -> None:
+    """Not clipped into the range: the explorer would show another P0 than asked for."""
+    scenario = dataclasses.replace(DEFAULT, p0_variance=p0_variance)
+    with pytest.raises(ValueError, match=r"scenario\.p0_variance .*\[0\.01, 1000000\] cm²"):
+        ic.explore_initial_covariance(scenario)

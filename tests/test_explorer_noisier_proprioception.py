@@ -6,7 +6,8 @@ import dataclasses
 
 import numpy as np
 import pytest
-from matplotlib.backends.backend_agg import FigureCanvasAgg
+from explorer_checks import fresh_figure
+from explorer_checks import lines_by_gid as _lines
 from matplotlib.figure import Figure
 
 from lqe_helpers.explorers.noisier_proprioception import (
@@ -25,24 +26,6 @@ from lqe_helpers.steady_state import steady_state
 TRIAL_GIDS = {"truth", "vision-only", "fused", "vision-only error", "fused error"}
 ONE_ROW = np.array([[1.0, 0.0, 0.0]])
 TWO_ROWS = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
-
-
-def _fresh_figure() -> Figure:
-    figure = Figure(figsize=(10.0, 5.0))
-    FigureCanvasAgg(figure)
-    return figure
-
-
-def _lines(figure: Figure) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """(x, y) of every line with a gid, by gid."""
-    found = {}
-    for ax in figure.axes:
-        for line in ax.lines:
-            if line.get_gid() is not None:
-                assert line.get_gid() not in found, f"duplicate line {line.get_gid()}"
-                found[line.get_gid()] = (np.asarray(line.get_xdata(), float),
-                                         np.asarray(line.get_ydata(), float))
-    return found
 
 
 def _filter(readings: np.ndarray, sigmas: list[float], scenario: Scenario):
@@ -127,7 +110,7 @@ def test_noise_stays_fixed_across_slider_moves():
 
 
 def test_theory_curve_matches_separate_riccati_solves():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     draw_noisier_proprioception(figure, sigma_p=4.5)
     lines = _lines(figure)
     x, y = lines["theory fused"]
@@ -165,7 +148,7 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
         explorer.sliders["sigma_p"].value = sigma_p
     assert explorer.figure.axes == axes
     assert len(axes) == 3
-    fresh = _fresh_figure()
+    fresh = fresh_figure()
     draw_noisier_proprioception(fresh, sigma_p=7.5)
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     assert set(reused) == set(drawn)
@@ -177,14 +160,14 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     noise = np.random.default_rng(3).standard_normal((DEFAULT.n_steps, 2))
     draw_noisier_proprioception(figure, sigma_p=2.5, noise=noise)
     _check_figure(figure, 2.5, noise)
 
 
 def test_draw_function_clears_a_foreign_figure():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     figure.subplots(1, 4)
     draw_noisier_proprioception(figure, sigma_p=4.5)
     assert len(figure.axes) == 3
@@ -200,7 +183,7 @@ def test_explorer_follows_its_scenario():
 @pytest.mark.parametrize("sigma_p", [0.0, -4.5, float("inf")])
 def test_bad_sigma_p_raises(sigma_p):
     with pytest.raises(ValueError, match="sigma_p"):
-        draw_noisier_proprioception(_fresh_figure(), sigma_p=sigma_p)
+        draw_noisier_proprioception(fresh_figure(), sigma_p=sigma_p)
 
 
 def test_bad_inputs_to_the_theory_raise():
@@ -209,7 +192,7 @@ def test_bad_inputs_to_the_theory_raise():
     with pytest.raises(ValueError, match="sigma_v"):
         steady_position_variances(DEFAULT, 0.0, np.array([1.0]))
     with pytest.raises(ValueError, match="noise must have shape"):
-        draw_noisier_proprioception(_fresh_figure(), sigma_p=4.5, noise=np.zeros((3, 2)))
+        draw_noisier_proprioception(fresh_figure(), sigma_p=4.5, noise=np.zeros((3, 2)))
 
 
 def test_static_display_carries_the_picture_and_names_the_sliders():
@@ -222,7 +205,7 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
 
 
 def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
-    figure = _fresh_figure()
+    figure = fresh_figure()
     draw_noisier_proprioception(figure, sigma_p=30.0)
     theory_ax = figure.axes[2]
     figure.canvas.draw()

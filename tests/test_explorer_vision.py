@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-import io
+import dataclasses
 
 import numpy as np
 import pytest
-from matplotlib.axes import Axes
+from explorer_checks import band_matches, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, metrics
@@ -14,28 +14,9 @@ from lqe_helpers.explorers import vision
 from lqe_helpers.scenario import DEFAULT
 
 
-def line(ax: Axes, label: str) -> np.ndarray:
-    """y data of the one line labelled ``label``."""
-    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
-    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
-    return np.asarray(found[0].get_ydata(), float)
-
-
-def band_matches(ax: Axes, label: str, low: np.ndarray, high: np.ndarray) -> None:
-    """The filled band labelled ``label`` has its edges at ``low`` and ``high``."""
-    found = [c for c in ax.collections if c.get_label() == label]
-    assert len(found) == 1, f"expected one band labelled {label!r}, got {len(found)}"
-    vertices = np.concatenate([path.vertices for path in found[0].get_paths()])
-    index = np.rint(vertices[:, 0] / DEFAULT.dt).astype(int)
-    on_edge = (np.isclose(vertices[:, 1], low[index], rtol=0, atol=1e-9)
-               | np.isclose(vertices[:, 1], high[index], rtol=0, atol=1e-9))
-    assert on_edge.all()
-    # Both edges are traced over every sample.
-    assert np.unique(index).size == low.size
-
-
-@pytest.fixture(scope="module")
+@pytest.fixture
 def explorer():
+    """A new explorer for every test, so no test sees another's slider moves."""
     return vision.explore_vision()
 
 
@@ -88,7 +69,6 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
         patterns.append((line(ax, vision.VISION_LABEL) - truth) / sigma_v)
     np.testing.assert_allclose(patterns[0], patterns[1], rtol=0, atol=1e-12)
     np.testing.assert_array_equal(patterns[0], patterns[2])
-    explorer.sliders["sigma_v"].value = DEFAULT.sigma_v
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
@@ -139,10 +119,17 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert explorer.png.startswith(b"\x89PNG")
 
 
-def png(figure: Figure) -> bytes:
-    buffer = io.BytesIO()
-    figure.savefig(buffer, format="png", dpi=60, metadata={"Software": None})
-    return buffer.getvalue()
+def test_slider_starts_at_the_scenarios_sigma_v() -> None:
+    scenario = dataclasses.replace(DEFAULT, sigma_v=4.5)
+    assert vision.explore_vision(scenario).sliders["sigma_v"].value == 4.5
+
+
+@pytest.mark.parametrize("sigma_v", [0.05, 12.0])
+def test_scenario_outside_the_slider_range_is_refused(sigma_v: float) -> None:
+    """Not clipped into the range: the explorer would show another σ_v than asked for."""
+    scenario = dataclasses.replace(DEFAULT, sigma_v=sigma_v)
+    with pytest.raises(ValueError, match=rf"scenario\.sigma_v .*\[0\.1, 10\] cm, got {sigma_v:g}"):
+        vision.explore_vision(scenario)
 
 
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:

@@ -47,7 +47,20 @@ GOOD = {
         ({"B": np.ones((2, 1)), "u": np.ones((10, 1))}, r"B must have shape \(3, p\)"),
         (
             {"B": np.ones((3, 1)), "u": np.ones((9, 1))},
-            r"u must have trailing shape \(n, p\) = \(10, 1\)",
+            r"u must have trailing shape \(n, p\) = \(10, 1\) to match y and B, got shape \(9, 1\)",
+        ),
+        (
+            {"B": np.ones((3, 2)), "u": np.ones((10, 1))},
+            r"u must have trailing shape \(n, p\) = \(10, 2\) to match y and B, "
+            r"got shape \(10, 1\)",
+        ),
+        (
+            {"B": np.ones((3, 1)), "u": np.full((10, 1), np.nan)},
+            "u must contain only finite numbers, got 10 NaN",
+        ),
+        (
+            {"y": np.zeros((2, 10, 1)), "B": np.ones((3, 1)), "u": np.ones((4, 10, 1))},
+            r"leading batch axes must broadcast against each other, got y \(2,\), .*u \(4,\)",
         ),
     ],
 )

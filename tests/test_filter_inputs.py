@@ -160,21 +160,3 @@ def test_input_shifts_the_estimate_by_its_own_response() -> None:
     response = driven - free
     np.testing.assert_allclose(response[0], response[1], rtol=0, atol=1e-12)
     assert np.max(np.abs(response)) > 1e-3
-
-
-@pytest.mark.parametrize(
-    ("B", "u", "match"),
-    [(np.ones((3, 1)), None, "B and u"),
-     (None, np.ones((10, 1)), "B and u"),
-     (np.ones((2, 1)), np.ones((10, 1)), "B must have shape"),
-     (np.ones((3, 1)), np.ones((9, 1)), "u must have trailing shape"),
-     (np.ones((3, 2)), np.ones((10, 1)), "u must have trailing shape"),
-     (np.ones((3, 1)), np.full((10, 1), np.nan), "u must contain only finite"),
-     (np.ones((3, 1)), np.ones((4, 10, 1)), "leading batch axes")],
-)
-def test_bad_inputs_are_rejected_by_name(B, u, match: str) -> None:
-    model = random_model(10, 3, 1, 1)
-    y = np.zeros((2, 10, 1))
-    with pytest.raises(ValueError, match=match):
-        kalman_filter(y, model["A"], model["C"], model["Q"], model["R"], model["z0"],
-                      model["P0"], B=B, u=u)

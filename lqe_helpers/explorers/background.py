@@ -22,7 +22,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
 from .. import experiments, model, validation
-from ..explorer import Explorer, log_slider, reuse_panels
+from ..explorer import Explorer, log_slider, reuse_panels, starting_value
 from ..plotting import COLORS, label_time_position, style
 from ..prediction import OpenLoop, amplitude_crossing, open_loop
 from ..scenario import DEFAULT, Scenario
@@ -164,10 +164,21 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
 
 
 def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
-    """Slider for σ_j (log scale): open-loop growth and tracking respond together."""
+    """Slider for σ_j (log scale): open-loop growth and tracking respond together.
+
+    The slider starts at the scenario's σ_j,
+    :attr:`~lqe_helpers.scenario.Scenario.process_jerk_std`.
+
+    Raises
+    ------
+    ValueError
+        If that σ_j lies outside the slider's range :data:`JERK_STD_RANGE`.
+    """
+    start = starting_value("process_jerk_std", scenario.process_jerk_std, *JERK_STD_RANGE,
+                           "cm/s³")
     noise = scenario.unit_noise(sensors=("vision",))
-    slider = log_slider("σ_j (cm/s³)", scenario.process_jerk_std, *JERK_STD_RANGE,
-                        steps_per_decade=8, readout_format=".0f")
+    slider = log_slider("σ_j (cm/s³)", start, *JERK_STD_RANGE, steps_per_decade=8,
+                        readout_format=".0f")
     return Explorer(
         "Jerk noise σ_j: open-loop growth and tracking",
         {"jerk_std": slider},

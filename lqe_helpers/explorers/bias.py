@@ -24,7 +24,7 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model
-from ..explorer import Explorer, float_slider, log_slider, reuse_panels
+from ..explorer import Explorer, float_slider, log_slider, reuse_panels, starting_value
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -171,16 +171,24 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
     """Sliders for b (cm/s²), σ_a (cm/s², log scale) and σ_v (cm) over :func:`draw_bias`.
 
     Both noise streams are drawn once from the scenario's seed and kept, so a slider
-    rescales the same noise instead of drawing new noise.
+    rescales the same noise instead of drawing new noise. b and σ_a start at
+    :data:`~lqe_helpers.bias_model.DEFAULT_BIAS` and
+    :data:`~lqe_helpers.bias_model.DEFAULT_SIGMA_A`, σ_v at the scenario's.
+
+    Raises
+    ------
+    ValueError
+        If ``scenario.sigma_v`` lies outside the slider's range :data:`SIGMA_V_RANGE`.
     """
+    start_sigma_v = starting_value("sigma_v", scenario.sigma_v, *SIGMA_V_RANGE, "cm")
     noise = bias_model.unit_noise(scenario)
     sliders = {
         "bias": float_slider("b (cm/s²)", bias_model.DEFAULT_BIAS, *BIAS_RANGE, BIAS_STEP,
                              readout_format=".0f"),
         "sigma_a": log_slider("σ_a (cm/s²)", bias_model.DEFAULT_SIGMA_A, *SIGMA_A_RANGE,
                               steps_per_decade=8, readout_format=".3g"),
-        "sigma_v": float_slider("σ_v (cm)", float(np.clip(scenario.sigma_v, *SIGMA_V_RANGE)),
-                                *SIGMA_V_RANGE, SIGMA_V_STEP, readout_format=".1f"),
+        "sigma_v": float_slider("σ_v (cm)", start_sigma_v, *SIGMA_V_RANGE, SIGMA_V_STEP,
+                                readout_format=".1f"),
     }
     return Explorer(
         "A biased acceleration signal corrected by vision",

@@ -20,7 +20,7 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch
 
 from .. import experiments
-from ..explorer import Explorer, float_slider, reuse_panels
+from ..explorer import Explorer, float_slider, reuse_panels, starting_value
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -169,15 +169,21 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
     The slider runs from 0 to :data:`MAX_DELAY` (or the last whole step before the
     end of the trial, if that is shorter) in steps of Δt, starting at the scenario's
     delay; a value between steps is rounded to the nearest step.
+
+    Raises
+    ------
+    ValueError
+        If ``scenario.delay`` lies beyond the slider's range.
     """
+    high = math.floor(min(MAX_DELAY, (scenario.n_steps - 1) * scenario.dt) / scenario.dt
+                      + 1e-9) * scenario.dt
+    start = starting_value("delay", scenario.delay, 0.0, high, "s")
     noise = scenario.unit_noise(sensors=SENSORS)
     # A delay changes only when the filter's output arrives, not the output itself:
     # filter the fixed noise once and let the slider shift and predict that run.
     tracking = experiments.track(scenario, SENSORS, noise=noise)
-    high = math.floor(min(MAX_DELAY, (scenario.n_steps - 1) * scenario.dt) / scenario.dt
-                      + 1e-9) * scenario.dt
     decimals = max(2, math.ceil(-math.log10(scenario.dt) - 1e-9))
-    slider = float_slider("delay (s)", value=min(scenario.delay, high), low=0.0, high=high,
+    slider = float_slider("delay (s)", value=start, low=0.0, high=high,
                           step=scenario.dt, readout_format=f".{decimals}f")
     return Explorer(
         "Sensory delay and its compensation: truth, delayed vision, delayed estimate and "

@@ -9,22 +9,28 @@ correction, which follow the reliabilities ``1/σ_v²`` and ``1/σ_p²``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
 from functools import lru_cache, partial
 from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
 from matplotlib.patches import Rectangle
 from matplotlib.text import Annotation
 
 from .. import experiments, validation
-from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
-from ..plotting import COLORS, plot_band, style
+from ..cue_combination import reliability_weights
+from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels, starting_value
+from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
+from ._trial import (
+    TrialLine,
+    TrialPanels,
+    build_trial_panels,
+    estimate_lines,
+    legend_handles,
+    set_trial_title,
+)
 
 #: The fused filter's sensors, in the column order of its noise and gains.
 FUSED = ("vision", "proprioception")
@@ -32,11 +38,7 @@ FUSED = ("vision", "proprioception")
 #: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_RANGE = (0.5, 6.0, 0.25)
 
-#: A line of a trial's left column: (panel, role, legend label or None). Panel 0
-#: holds the signals, panel 1 the errors (estimate − true position).
-TrialLine = tuple[int, str, str | None]
-
-#: Plotted lines by gid.
+#: Plotted lines by gid (see :data:`~._trial.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "vision readings": (0, "vision", "vision readings"),
     "proprioception readings": (0, "proprioception", "proprioception readings"),
@@ -57,13 +59,8 @@ def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarra
     """
     if noise is None:
         return scenario.unit_noise(sensors=FUSED)
-    noise = validation.finite_array("noise", noise, min_ndim=2)
-    expected = (scenario.n_steps, len(FUSED))
-    if noise.shape != expected:
-        raise ValueError(
-            f"noise must have shape {expected} (vision, proprioception), got shape {noise.shape}"
-        )
-    return noise
+    return validation.shaped_array("noise", noise, (scenario.n_steps, len(FUSED)),
+                                   ", ".join(FUSED))
 
 
 @lru_cache(maxsize=16)
@@ -139,9 +136,11 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     vision = vision_only(scenario, sigma_v, noise)
     fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
     truth = scenario.truth[:, 0]
-    # Share of the position correction each sense receives once the gain has settled.
-    position_gain = fused.result.gains[-1, 0, :]
-    weights = position_gain / position_gain.sum()
+    # Share of the position correction each sense receives. The gain is K = P Cᵀ R⁻¹
+    # (P the estimate's covariance) and C's rows are identical, so K's position row
+    # is P[0, 0] · (1/σ_v², 1/σ_p²) at every step: the shares of the settled gain
+    # are exactly the reliability weights (tests/test_cue_combination.py).
+    weights = reliability_weights([sigma_v, sigma_p])
 
     panels = reuse_panels(figure, _build, scenario)
     data = {
@@ -158,84 +157,6 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
         text.set_text(f"{100 * weight:.0f} %")
         text.xy = (bar.get_x() + bar.get_width() / 2, weight)
     set_trial_title(figure, scenario, sigma_v, sigma_p, vision, fused)
-
-
-# The trial column (signals over errors) beside a side panel, shared with
-# lqe_helpers.explorers.noisier_proprioception.
-
-
-class TrialPanels(NamedTuple):
-    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
-
-    signals: Axes
-    errors: Axes
-    side: Axes
-    lines: dict[str, Line2D]
-
-
-def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, TrialLine], *,
-                       width_ratios: tuple[float, float], height_ratios: tuple[float, float],
-                       top: float, wspace: float, signal_limit: float,
-                       error_limit: float) -> TrialPanels:
-    """Lay out one trial over ``scenario.times`` beside a side panel, on an empty figure.
-
-    The left column holds the signals (position, ±``signal_limit`` cm) above the
-    errors (estimate − true position, ±``error_limit`` cm, with a zero line); each
-    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data.
-    Shared by this explorer and :mod:`lqe_helpers.explorers.noisier_proprioception`;
-    the caller adds the legend and fills the side panel.
-    """
-    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
-                               left=0.07, right=0.98, bottom=0.1, top=top,
-                               hspace=0.1, wspace=wspace)
-    signals = figure.add_subplot(grid[0, 0])
-    errors = figure.add_subplot(grid[1, 0], sharex=signals)
-    side = figure.add_subplot(grid[:, 1])
-    times = scenario.times
-    column = (signals, errors)
-    drawn = {}
-    for gid, (panel, role, label) in lines.items():
-        extra = {"linewidth": 1.0} if panel == 1 else {}
-        (drawn[gid],) = column[panel].plot(times, np.zeros_like(times),
-                                           **style(role, gid=gid, label=label, **extra))
-    signals.set_ylim(-signal_limit, signal_limit)
-    signals.set_ylabel("position (cm)")
-    signals.tick_params(labelbottom=False)
-    errors.axhline(0.0, **style("truth", linewidth=0.8))
-    errors.set_ylim(-error_limit, error_limit)
-    errors.set_xlim(0.0, scenario.duration)
-    errors.set_xlabel("time (s)")
-    errors.set_ylabel("error (cm)")
-    figure.align_ylabels(column)
-    return TrialPanels(signals, errors, side, drawn)
-
-
-def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
-    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
-    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
-
-
-def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,
-                   fused: experiments.Tracking) -> dict[str, np.ndarray]:
-    """y data (cm) of the truth, both estimates and their errors, by line gid."""
-    return {
-        "truth": truth,
-        "vision-only": vision.positions,
-        "fused": fused.positions,
-        "vision-only error": vision.positions - truth,
-        "fused error": fused.positions - truth,
-    }
-
-
-def set_trial_title(figure: Figure, scenario: Scenario, sigma_v: float, sigma_p: float,
-                    vision: experiments.Tracking, fused: experiments.Tracking) -> None:
-    """Title ``figure`` with both σ's and the trial's MSEs after the burn-in."""
-    figure.suptitle(
-        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
-        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
-        f"fused {float(fused.mse()):.3f} cm²",
-        x=0.07, y=0.985, ha="left", fontsize=10,
-    )
 
 
 class _Panels(NamedTuple):
@@ -284,14 +205,20 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
 
     The unit noise is drawn once from the scenario and kept, so a slider changes
     only how loud a sense is, never its noise pattern. The sliders start at the
-    scenario's σ_v and σ_p (question (c): 1.5 cm each), clipped into their range.
+    scenario's σ_v and σ_p (question (c): 1.5 cm each).
+
+    Raises
+    ------
+    ValueError
+        If ``scenario.sigma_v`` or ``scenario.sigma_p`` lies outside the sliders' range
+        :data:`SIGMA_RANGE`.
     """
     low, high, step = SIGMA_RANGE
+    start_v = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
+    start_p = starting_value("sigma_p", scenario.sigma_p, low, high, "cm")
     sliders = {
-        "sigma_v": float_slider("σ_v (cm)", float(np.clip(scenario.sigma_v, low, high)),
-                                low, high, step),
-        "sigma_p": float_slider("σ_p (cm)", float(np.clip(scenario.sigma_p, low, high)),
-                                low, high, step),
+        "sigma_v": float_slider("σ_v (cm)", start_v, low, high, step),
+        "sigma_p": float_slider("σ_p (cm)", start_p, low, high, step),
     }
     draw = partial(draw_fusion, scenario=scenario, noise=unit_noise(scenario))
     return Explorer("Vision alone against vision + proprioception", sliders, draw,

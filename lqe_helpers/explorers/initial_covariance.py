@@ -25,7 +25,7 @@ from matplotlib.text import Text
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..explorer import Explorer, log_slider, reuse_panels
+from ..explorer import Explorer, log_slider, reuse_panels, starting_value
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -78,7 +78,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
         ax.set_xlabel("time (s)")
     position_ax.set_ylabel("position (cm)")
     velocity_ax.set_ylabel("velocity (cm/s)")
-    speed = scenario.amplitude * 2.0 * np.pi * scenario.frequency
+    speed = scenario.peak_speed
     velocity_ax.set_ylim(-2.0 * speed, 2.0 * speed)
     figure.legend(*position_ax.get_legend_handles_labels(), loc="lower center", ncol=4,
                   fontsize=9, markerscale=3)
@@ -154,18 +154,23 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     Parameters
     ----------
     scenario : Scenario
-        Constants of the simulation; the slider starts at its ``p0_variance``
-        (clipped into the slider's range).
+        Constants of the simulation; the slider starts at its ``p0_variance``.
 
     Returns
     -------
     Explorer
         Display it in JupyterLab to get the live slider.
+
+    Raises
+    ------
+    ValueError
+        If ``scenario.p0_variance`` lies outside the slider's range :data:`P0_RANGE`.
     """
-    noise = scenario.unit_noise(sensors=("vision",))
     low, high = P0_RANGE
-    slider = log_slider("P0 (cm²)", float(np.clip(scenario.p0_variance, low, high)), low, high,
-                        steps_per_decade=P0_STEPS_PER_DECADE, readout_format=".3g")
+    start = starting_value("p0_variance", scenario.p0_variance, low, high, "cm²")
+    noise = scenario.unit_noise(sensors=("vision",))
+    slider = log_slider("P0 (cm²)", start, low, high, steps_per_decade=P0_STEPS_PER_DECADE,
+                        readout_format=".3g")
     return Explorer(
         "The start of vision-only tracking as the initial covariance P0 changes",
         {"p0_variance": slider},

@@ -18,21 +18,20 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
 from .. import experiments, model, validation
+from ..cue_combination import reliability_weights
 from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
-from .fusion import (
-    FUSED,
+from ._trial import (
     TrialLine,
     TrialPanels,
     build_trial_panels,
     estimate_lines,
     legend_handles,
     set_trial_title,
-    unit_noise,
-    vision_only,
 )
+from .fusion import FUSED, unit_noise, vision_only
 
 #: σ_p (cm) of question (d), where the slider starts.
 QUESTION_SIGMA_P = 4.5
@@ -43,7 +42,7 @@ SIGMA_P_RANGE = (0.5, 30.0, 0.5)
 #: σ_p (cm) spanned by the theoretical curve in the right panel.
 CURVE_RANGE = (0.3, 100.0)
 
-#: Plotted lines of the left column by gid (see :data:`~.fusion.TrialLine`).
+#: Plotted lines of the left column by gid (see :data:`~._trial.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "truth": (0, "truth", "true position"),
     "vision-only": (0, "alternative", "vision-only estimate"),
@@ -135,9 +134,9 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
     truth = scenario.truth[:, 0]
     _, theory_now = steady_position_variances(scenario, sigma_v, np.array([sigma_p]))
-    # Proprioception's share of the position correction once the gain has settled.
-    position_gain = fused.result.gains[-1, 0, :]
-    weight_p = float(position_gain[1] / position_gain.sum())
+    # Proprioception's share of the settled position gain: its reliability weight
+    # (see draw_fusion in lqe_helpers.explorers.fusion for why they are equal).
+    weight_p = float(reliability_weights([sigma_v, sigma_p])[1])
 
     panels = reuse_panels(figure, _build, scenario)
     for gid, values in estimate_lines(truth, vision, fused).items():

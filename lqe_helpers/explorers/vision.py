@@ -23,7 +23,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments, validation
-from ..explorer import Explorer, float_slider, reuse_panels
+from ..explorer import Explorer, float_slider, reuse_panels, starting_value
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -125,18 +125,22 @@ def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
     Parameters
     ----------
     scenario : Scenario
-        Constants of the simulation; the slider starts at its ``sigma_v`` (clipped
-        into the slider's range).
+        Constants of the simulation; the slider starts at its ``sigma_v``.
 
     Returns
     -------
     Explorer
         Display it in JupyterLab to get the live slider.
+
+    Raises
+    ------
+    ValueError
+        If ``scenario.sigma_v`` lies outside the slider's range :data:`SIGMA_V_RANGE`.
     """
-    noise = scenario.unit_noise(sensors=("vision",))
     low, high = SIGMA_V_RANGE
-    slider = float_slider("σ_v (cm)", float(np.clip(scenario.sigma_v, low, high)), low, high,
-                          SIGMA_V_STEP, readout_format=".1f")
+    start = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
+    noise = scenario.unit_noise(sensors=("vision",))
+    slider = float_slider("σ_v (cm)", start, low, high, SIGMA_V_STEP, readout_format=".1f")
     return Explorer(
         "Vision-only tracking as the vision noise σ_v changes",
         {"sigma_v": slider},

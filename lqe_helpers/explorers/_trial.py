@@ -1,0 +1,99 @@
+"""The one-trial layout shared by the fusion explorers of questions (c) and (d).
+
+Both :mod:`lqe_helpers.explorers.fusion` and
+:mod:`lqe_helpers.explorers.noisier_proprioception` show one trial of a vision-only
+and a fused filter in a left column (signals over errors) beside a side panel of
+their own, with a legend above and the trial's MSEs in the title. This module holds
+that common part; each explorer fills its side panel.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import NamedTuple
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+from .. import experiments
+from ..plotting import style
+from ..scenario import Scenario
+
+#: A line of a trial's left column: (panel, role, legend label or None). Panel 0
+#: holds the signals, panel 1 the errors (estimate − true position).
+TrialLine = tuple[int, str, str | None]
+
+
+class TrialPanels(NamedTuple):
+    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
+
+    signals: Axes
+    errors: Axes
+    side: Axes
+    lines: dict[str, Line2D]
+
+
+def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, TrialLine], *,
+                       width_ratios: tuple[float, float], height_ratios: tuple[float, float],
+                       top: float, wspace: float, signal_limit: float,
+                       error_limit: float) -> TrialPanels:
+    """Lay out one trial over ``scenario.times`` beside a side panel, on an empty figure.
+
+    The left column holds the signals (position, ±``signal_limit`` cm) above the
+    errors (estimate − true position, ±``error_limit`` cm, with a zero line); each
+    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data.
+    The caller adds the legend and fills the side panel.
+    """
+    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
+                               left=0.07, right=0.98, bottom=0.1, top=top,
+                               hspace=0.1, wspace=wspace)
+    signals = figure.add_subplot(grid[0, 0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals)
+    side = figure.add_subplot(grid[:, 1])
+    times = scenario.times
+    column = (signals, errors)
+    drawn = {}
+    for gid, (panel, role, label) in lines.items():
+        extra = {"linewidth": 1.0} if panel == 1 else {}
+        (drawn[gid],) = column[panel].plot(times, np.zeros_like(times),
+                                           **style(role, gid=gid, label=label, **extra))
+    signals.set_ylim(-signal_limit, signal_limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.axhline(0.0, **style("truth", linewidth=0.8))
+    errors.set_ylim(-error_limit, error_limit)
+    errors.set_xlim(0.0, scenario.duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels(column)
+    return TrialPanels(signals, errors, side, drawn)
+
+
+def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
+    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
+    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
+
+
+def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,
+                   fused: experiments.Tracking) -> dict[str, np.ndarray]:
+    """y data (cm) of the truth, both estimates and their errors, by line gid."""
+    return {
+        "truth": truth,
+        "vision-only": vision.positions,
+        "fused": fused.positions,
+        "vision-only error": vision.positions - truth,
+        "fused error": fused.positions - truth,
+    }
+
+
+def set_trial_title(figure: Figure, scenario: Scenario, sigma_v: float, sigma_p: float,
+                    vision: experiments.Tracking, fused: experiments.Tracking) -> None:
+    """Title ``figure`` with both σ's and the trial's MSEs after the burn-in."""
+    figure.suptitle(
+        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
+        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
+        f"fused {float(fused.mse()):.3f} cm²",
+        x=0.07, y=0.985, ha="left", fontsize=10,
+    )

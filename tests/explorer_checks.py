@@ -1,0 +1,69 @@
+"""Checks shared by the explorer tests: find a figure's lines and bands, render it.
+
+Imported by the ``tests/test_explorer*.py`` files as ``explorer_checks`` (pytest puts
+``tests/`` on ``sys.path``, as for ``conftest.py``). Not a test module itself.
+"""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
+
+from lqe_helpers.scenario import DEFAULT
+
+
+def line(ax: Axes, label: str) -> np.ndarray:
+    """y data of the one line of ``ax`` labelled ``label``."""
+    found = [artist for artist in ax.get_lines() if artist.get_label() == label]
+    assert len(found) == 1, f"expected one line labelled {label!r}, got {len(found)}"
+    return np.asarray(found[0].get_ydata(), float)
+
+
+def lines_by_gid(figure: Figure) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """(x, y) data of every line of ``figure`` that has a gid, by gid (each gid once)."""
+    found = {}
+    for ax in figure.axes:
+        for artist in ax.lines:
+            gid = artist.get_gid()
+            if gid is not None:
+                assert gid not in found, f"duplicate line {gid}"
+                found[gid] = (np.asarray(artist.get_xdata(), float),
+                              np.asarray(artist.get_ydata(), float))
+    return found
+
+
+def band_matches(ax: Axes, label: str, low: np.ndarray, high: np.ndarray,
+                 dt: float = DEFAULT.dt) -> None:
+    """The filled band of ``ax`` labelled ``label`` traces ``low`` and ``high``.
+
+    ``low[j]`` and ``high[j]`` are the band's edges at time ``j · dt``; every vertex
+    of the band lies on one of them (to 1e-9 relative to the largest edge value, at
+    least 1e-9 absolute) and both are traced over every sample.
+    """
+    found = [c for c in ax.collections if c.get_label() == label]
+    assert len(found) == 1, f"expected one band labelled {label!r}, got {len(found)}"
+    vertices = np.concatenate([path.vertices for path in found[0].get_paths()])
+    index = np.rint(vertices[:, 0] / dt).astype(int)
+    tolerance = 1e-9 * max(1.0, float(np.max(np.abs(low))), float(np.max(np.abs(high))))
+    on_edge = (np.isclose(vertices[:, 1], low[index], rtol=0, atol=tolerance)
+               | np.isclose(vertices[:, 1], high[index], rtol=0, atol=tolerance))
+    assert on_edge.all()
+    assert np.unique(index).size == low.size
+
+
+def png(figure: Figure, dpi: int = 60) -> bytes:
+    """``figure`` rendered to PNG bytes (no metadata, so equal pictures give equal bytes)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", dpi=dpi, metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def fresh_figure(figsize: tuple[float, float] = (10.0, 5.0)) -> Figure:
+    """An empty figure with an Agg canvas, as an explorer makes one."""
+    figure = Figure(figsize=figsize)
+    FigureCanvasAgg(figure)
+    return figure
