@@ -264,3 +264,27 @@ def fit_sinusoid(times: np.ndarray, signal: np.ndarray, frequency: float) -> Sin
     amplitude = np.hypot(sine, cosine).reshape(shape)
     lead = (np.arctan2(cosine, sine) / omega).reshape(shape)
     return SinusoidFit(amplitude=amplitude, lead=lead)
+
+
+def power_law_exponent(x: np.ndarray, y: np.ndarray) -> float:
+    """Exponent ``a`` of the least-squares fit ``y ≈ c · x^a`` (the slope on log–log axes).
+
+    Parameters
+    ----------
+    x, y : array_like, shape (n,)
+        Positive values, n >= 2, ``x`` not all equal (e.g. time in s and an error in cm).
+
+    Returns
+    -------
+    float
+        The fitted exponent: 2.5 for a position spread that grows as t^{5/2}, say.
+    """
+    x = validation.positive_array("x", x, min_ndim=1)
+    y = validation.positive_array("y", y, min_ndim=1)
+    if x.ndim != 1 or x.shape != y.shape or x.size < 2:
+        raise ValueError(
+            f"x and y must have the same shape (n,) with n >= 2, got shapes {x.shape} and "
+            f"{y.shape}")
+    if np.ptp(x) == 0:
+        raise ValueError(f"x must not be all equal, got {x.size} values of {x[0]:g}")
+    return float(np.polyfit(np.log(x), np.log(y), 1)[0])

@@ -6,6 +6,8 @@ received and what is allowed, e.g. ``"sigma_v must be > 0 cm, got -1.5"``.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 import numpy as np
 
 #: Relative tolerance for "symmetric" and "positive semidefinite" checks.
@@ -20,28 +22,32 @@ def _describe(value: object) -> str:
     return f"an array of shape {array.shape}"
 
 
-def positive(name: str, value: float, unit: str = "") -> float:
-    """Return ``value`` as a float if it is finite and > 0, else raise ``ValueError``."""
-    unit_text = f" {unit}" if unit else ""
+def _number(name: str, value: object, requirement: str, unit_text: str,
+            allowed: Callable[[float], bool], non_numeric: str = "a number") -> float:
+    """``value`` as a finite float for which ``allowed`` holds, else a ``ValueError``.
+
+    The message says "``name`` must be a finite number``requirement````unit_text``" and
+    quotes ``value``; a value that is not a number at all is called ``non_numeric``.
+    """
     try:
         number = float(value)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number > 0{unit_text}, got {value!r}") from None
-    if not np.isfinite(number) or number <= 0:
-        raise ValueError(f"{name} must be a finite number > 0{unit_text}, got {value!r}")
+        raise ValueError(
+            f"{name} must be {non_numeric}{requirement}{unit_text}, got {value!r}") from None
+    if not np.isfinite(number) or not allowed(number):
+        raise ValueError(
+            f"{name} must be a finite number{requirement}{unit_text}, got {value!r}")
     return number
+
+
+def positive(name: str, value: float, unit: str = "") -> float:
+    """Return ``value`` as a float if it is finite and > 0, else raise ``ValueError``."""
+    return _number(name, value, " > 0", f" {unit}" if unit else "", lambda x: x > 0)
 
 
 def non_negative(name: str, value: float, unit: str = "") -> float:
     """Return ``value`` as a float if it is finite and >= 0, else raise ``ValueError``."""
-    unit_text = f" {unit}" if unit else ""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a number >= 0{unit_text}, got {value!r}") from None
-    if not np.isfinite(number) or number < 0:
-        raise ValueError(f"{name} must be a finite number >= 0{unit_text}, got {value!r}")
-    return number
+    return _number(name, value, " >= 0", f" {unit}" if unit else "", lambda x: x >= 0)
 
 
 def count(name: str, value: int, minimum: int = 0, maximum: int | None = None) -> int:
@@ -56,14 +62,8 @@ def count(name: str, value: int, minimum: int = 0, maximum: int | None = None) -
 
 def finite_number(name: str, value: float, unit: str = "") -> float:
     """Return ``value`` as a float if it is a finite number of any sign, else raise."""
-    unit_text = f" in {unit}" if unit else ""
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a finite number{unit_text}, got {value!r}") from None
-    if not np.isfinite(number):
-        raise ValueError(f"{name} must be a finite number{unit_text}, got {value!r}")
-    return number
+    return _number(name, value, "", f" in {unit}" if unit else "", lambda x: True,
+                   non_numeric="a finite number")
 
 
 def whole_steps(name: str, value: float, dt: float) -> int:

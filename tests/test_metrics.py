@@ -146,3 +146,20 @@ def test_fit_sinusoid_ignores_independent_noise_on_average():
 def test_fit_sinusoid_bad_input(times, signal, frequency, name):
     with pytest.raises(ValueError, match=name):
         metrics.fit_sinusoid(times, signal, frequency)
+
+
+def test_power_law_exponent_of_exact_power_laws():
+    t = np.geomspace(0.01, 10.0, 50)
+    assert metrics.power_law_exponent(t, 3.0 * t**2.5) == pytest.approx(2.5, abs=1e-12)
+    assert metrics.power_law_exponent(t, 0.2 / t) == pytest.approx(-1.0, abs=1e-12)
+
+
+@pytest.mark.parametrize(("x", "y", "name"), [
+    ([1.0, 2.0], [1.0, 0.0], "y"),
+    ([0.0, 2.0], [1.0, 2.0], "x"),
+    ([1.0, 2.0, 3.0], [1.0, 2.0], "x and y"),
+    ([2.0, 2.0], [1.0, 2.0], "x must not be all equal"),
+])
+def test_power_law_exponent_bad_input(x, y, name):
+    with pytest.raises(ValueError, match=name):
+        metrics.power_law_exponent(x, y)
