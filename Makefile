@@ -35,15 +35,15 @@ test: $(STAMP) lint
 
 # Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
 notebooks: $(STAMP)
-	$(BIN)/python -m lqe_helpers.notebook_runner notebooks/*.ipynb
+	$(BIN)/python -m lqe_helpers.authoring.notebook_runner notebooks/*.ipynb
 
 # HTML handouts in build/handouts/ (index.html; prose/ without code), executed afresh.
 handouts: $(STAMP)
-	$(BIN)/python -m lqe_helpers.handouts --source notebooks --out build/handouts
+	$(BIN)/python -m lqe_helpers.authoring.handouts --source notebooks --out build/handouts
 
 # Student edition in build/student/: solutions replaced by stubs, answers by prompts.
 student: $(STAMP)
-	$(BIN)/python -m lqe_helpers.student_edition --source notebooks --out build/student
+	$(BIN)/python -m lqe_helpers.authoring.student_edition --source notebooks --out build/student
 
 # Speed against a peer in the same process (ratios, not pass/fail): filter and sliders.
 bench: $(STAMP)

@@ -5,9 +5,14 @@ Nothing here runs on import. A notebook opts in with :func:`use_pack_style`.
 
 from __future__ import annotations
 
+import base64
+import io
+
 import matplotlib as mpl
+import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 
 #: Okabe–Ito colours by role, the same in every notebook.
 COLORS = {
@@ -73,3 +78,38 @@ def label_time_position(ax: Axes, position_unit: str = "cm") -> None:
     """Standard axis labels: time (s) against position."""
     ax.set_xlabel("time (s)")
     ax.set_ylabel(f"position ({position_unit})")
+
+
+def figure_png(figure: Figure) -> bytes:
+    """The figure as PNG bytes, cropped like the notebook's inline backend (deterministic)."""
+    buffer = io.BytesIO()
+    figure.savefig(buffer, format="png", bbox_inches="tight", metadata={"Software": None})
+    return buffer.getvalue()
+
+
+def show_figure(figure: Figure, description: str) -> None:
+    """Display ``figure`` as a static PNG described by ``description``, then close it.
+
+    The description is the figure's alt text: one or two sentences saying what the
+    figure shows, written beside the figure in the notebook. It travels with the
+    output (``metadata["image/png"]["alt"]``, read by the handouts) and is the
+    output's plain-text form, so a reader without the picture still gets it.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure to show; it is closed afterwards, so it is not drawn twice.
+    description : str
+        What the figure shows, in words (not empty).
+    """
+    from IPython.display import display
+
+    if not isinstance(description, str) or not description.strip():
+        raise ValueError(f"description must be a non-empty sentence, got {description!r}")
+    png = figure_png(figure)
+    plt.close(figure)
+    display(
+        {"image/png": base64.b64encode(png).decode("ascii"), "text/plain": description.strip()},
+        raw=True,
+        metadata={"image/png": {"alt": description.strip()}},
+    )

@@ -21,8 +21,8 @@ import soupsieve
 from bs4 import BeautifulSoup
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
-from lqe_helpers import handouts
-from lqe_helpers.student_edition import EXPLORER_TAG
+from lqe_helpers.authoring import handouts
+from lqe_helpers.authoring.student_edition import EXPLORER_TAG
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 REAL = sorted(path.stem for path in NOTEBOOKS.glob("*.ipynb"))

@@ -19,7 +19,7 @@ from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
-from lqe_helpers import student_edition as se
+from lqe_helpers.authoring import student_edition as se
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 REAL = sorted(path.name for path in NOTEBOOKS.glob("*.ipynb"))

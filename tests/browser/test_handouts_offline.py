@@ -15,7 +15,7 @@ import pytest
 from lab_driver import NOTEBOOK_DIR, course_notebooks, screenshot_path
 from offline_pages import OfflinePage, open_offline
 
-from lqe_helpers.handouts import DEFAULT_MATHJAX_URL, build_handouts
+from lqe_helpers.authoring.handouts import DEFAULT_MATHJAX_URL, build_handouts
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
 

@@ -1,6 +1,6 @@
 """Build HTML handouts: every notebook executed fresh and rendered as one offline page.
 
-``python -m lqe_helpers.handouts [--source notebooks] [--out build/handouts]`` (or
+``python -m lqe_helpers.authoring.handouts [--source notebooks] [--out build/handouts]`` (or
 ``make handouts``) writes::
 
     build/handouts/index.html          links to every page, in notebook order
@@ -9,7 +9,7 @@
     build/handouts/prose/NN_name.html  prose, printed results and figures only
 
 Each notebook is executed once, in a fresh kernel, by
-:func:`lqe_helpers.notebook_runner.execute_notebook`. A notebook that raises, shows an
+:func:`lqe_helpers.authoring.notebook_runner.execute_notebook`. A notebook that raises, shows an
 error output, or displays a widget with no static view (which a page could only show
 as a placeholder) stops the build, and the message names the notebook and the cell
 (and gives the traceback); output on stderr (a warning) is reported but kept. Only
@@ -51,8 +51,8 @@ from nbconvert.preprocessors import Preprocessor
 from traitlets import List, Unicode
 from traitlets.config import Config
 
-from lqe_helpers.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook, fail
-from lqe_helpers.student_edition import check_out_dir, remove_stale, source_notebooks
+from lqe_helpers.authoring.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook, fail
+from lqe_helpers.authoring.student_edition import check_out_dir, remove_stale, source_notebooks
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"

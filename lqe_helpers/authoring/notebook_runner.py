@@ -1,6 +1,6 @@
 """Execute notebooks top to bottom in a fresh kernel and save them, ready to commit.
 
-``python -m lqe_helpers.notebook_runner notebooks/*.ipynb`` (or ``make notebooks``).
+``python -m lqe_helpers.authoring.notebook_runner notebooks/*.ipynb`` (or ``make notebooks``).
 The saved notebooks carry outputs but no widget state and no execution timings,
 so a re-run with unchanged code gives a byte-identical file.
 """

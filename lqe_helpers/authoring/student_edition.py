@@ -1,6 +1,6 @@
 """Build the student edition: the notebooks with their worked solutions taken out.
 
-``python -m lqe_helpers.student_edition [--source notebooks] [--out build/student]``
+``python -m lqe_helpers.authoring.student_edition [--source notebooks] [--out build/student]``
 (or ``make student``) writes one ``.ipynb`` per source notebook into the output folder.
 
 The source notebooks mark what is a solution with cell tags (one convention for the
@@ -49,7 +49,7 @@ from nbconvert.preprocessors import (
 )
 from traitlets import Unicode
 
-from lqe_helpers.notebook_runner import fail
+from lqe_helpers.authoring.notebook_runner import fail
 
 #: Tag of a code cell holding a worked solution (source notebooks).
 SOLUTION_TAG = "solution"
