@@ -110,6 +110,7 @@ def step_accelerations(scenario: Scenario) -> np.ndarray:
     unbiased model of :func:`transition_matrix` and :func:`input_matrix` reproduces
     the true velocity to rounding and the position to within 0.001 cm over a trial.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     times = scenario.times
     now = simulation.sinusoid_states(times, scenario.amplitude, scenario.frequency)
     before = simulation.sinusoid_states(times - scenario.dt, scenario.amplitude,
@@ -127,6 +128,7 @@ def true_states(scenario: Scenario, bias: float) -> np.ndarray:
     bias : float
         The constant true bias b of the acceleration signal in cm/s² (any sign).
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     bias = validation.finite_number("bias", bias, "cm/s²")
     states = scenario.truth[:, :3].copy()
     states[:, 2] = bias
@@ -135,6 +137,7 @@ def true_states(scenario: Scenario, bias: float) -> np.ndarray:
 
 def initial_state(scenario: Scenario, bias: float) -> np.ndarray:
     """True state ``[p, v, b]`` at ``t = −Δt``, the time ``z0`` refers to, shape (3,)."""
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     bias = validation.finite_number("bias", bias, "cm/s²")
     p, v, _ = simulation.sinusoid_states(np.array([-scenario.dt]), scenario.amplitude,
                                          scenario.frequency)[0]
@@ -242,6 +245,7 @@ def bias_drift(scenario: Scenario, bias: float) -> np.ndarray:
     ``t = −Δt``). The discrete integration of :func:`dead_reckoning` gives exactly
     this value at every sample.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     bias = validation.finite_number("bias", bias, "cm/s²")
     elapsed = scenario.times + scenario.dt
     return bias * elapsed**2 / 2.0
@@ -254,6 +258,7 @@ def dead_reckoning_spread(scenario: Scenario, sigma_a: float) -> np.ndarray:
     ``P = 0`` at the known start: how far the dead-reckoned position wanders even
     when the bias is known exactly. It grows roughly as ``σ_a √(Δt / 3) t^{3/2}``.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     dt = scenario.dt
     covariances = propagate_covariance(np.zeros((3, 3)), transition_matrix(dt),
                                        process_noise_covariance(dt, sigma_a), scenario.n_steps)
@@ -280,6 +285,7 @@ def unit_noise(scenario: Scenario, runs: int | None = None) -> np.ndarray:
     ndarray, shape (n, 2) or (runs, n, 2)
         Columns in the order of :data:`NOISE_COLUMNS`.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     streams = len(model.SENSORS) + 1
     rng = np.random.default_rng(scenario.seed)
     noise = simulation.unit_noise(rng, scenario.n_steps, streams, runs=runs)
@@ -384,6 +390,7 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
     InputTracking
         Leading axis: runs, if any.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     bias = validation.finite_number("bias", bias, "cm/s²")
     sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
     sigma_v = validation.positive(

@@ -54,6 +54,11 @@ class Tracking:
 
     def measurement_mse(self, sensor: str = "vision") -> np.ndarray:
         """Per-run MSE (cm²) of one sensor's raw readings after the burn-in, shape (...)."""
+        if not isinstance(sensor, str) or sensor not in self.sensors:
+            raise ValueError(
+                f"sensor must be one of the sensors this run simulated, {self.sensors}, "
+                f"got {sensor!r}"
+            )
         column = self.sensors.index(sensor)
         return metrics.mse(self.measurements[..., column], self.scenario.truth[:, 0],
                            self.scenario.burn_in_steps)
@@ -92,7 +97,8 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
         Leading axes: runs (if any), then the sweep axes of sigmas, assumed_sigmas and
         p0_variance broadcast together.
     """
-    sensors = tuple(sensors)
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    sensors = model.sensor_names(sensors)
     C = model.observation_matrix(sensors)
     defaults = {"vision": scenario.sigma_v, "proprioception": scenario.sigma_p}
     if sigmas is None:
@@ -158,7 +164,7 @@ class DelayedTracking:
         Skips the scenario's burn-in or the delay, whichever is longer.
         """
         arrays = {"delayed": self.delayed_estimates, "predicted": self.predictions}
-        if which not in arrays:
+        if not isinstance(which, str) or which not in arrays:
             raise ValueError(f"which must be one of {tuple(arrays)}, got {which!r}")
         scenario = self.tracking.scenario
         skip = max(scenario.burn_in_steps, self.steps)
@@ -175,6 +181,7 @@ def delay_and_compensate(tracking: Tracking, delay: float) -> DelayedTracking:
     delay : float
         Sensory delay d in s, a whole number of time steps (δ = d / Δt).
     """
+    validation.instance("tracking", tracking, Tracking, "from track()")
     scenario = tracking.scenario
     steps = scenario.delay_steps(delay)
     estimates = tracking.result.estimates

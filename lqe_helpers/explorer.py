@@ -14,7 +14,12 @@ they are the defaults) and saying that the sliders live in JupyterLab.
 Building a figure's axes, ticks and legends costs more than most filter runs, so a
 drawing function builds its panels once per figure with :func:`reuse_panels` and on
 later calls only replaces the data of the same artists; :func:`pin_axis_labels`
-saves the label placement of panels whose ticks never change.
+saves the label placement of panels whose ticks never change. Rendering them costs
+more still, so the explorer keeps a picture of everything a move leaves alone and
+repaints only the changed artists over it
+(:class:`~lqe_helpers.explorers._layers.LayeredCanvas`; the picture equals a full
+rendering). Axis limits that change in steps (:func:`set_ylim_in_steps`) and bands
+above the grid (:data:`DATA_UNDER_LINES`) keep that repaint small.
 """
 
 from __future__ import annotations
@@ -28,12 +33,24 @@ from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
 import ipywidgets as widgets
+import numpy as np
 from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from PIL import Image
 
 from . import validation
+from .explorers._layers import LayeredCanvas
+
+#: zorder of bands, bars and spans that a slider changes: above the grid and ticks
+#: (1.5, matplotlib's ``axes.axisbelow: line``) and below lines (2). At the default
+#: zorder 1 they would lie under the grid, and every move would repaint each axis
+#: with its tick labels (see :class:`~lqe_helpers.explorers._layers.LayeredCanvas`).
+DATA_UNDER_LINES = 1.6
+
+#: zlib level of the explorer's PNG (0 = none … 9 = smallest); see :func:`encode_png`.
+PNG_COMPRESS_LEVEL = 1
 
 #: Signature of a drawing function: it (re)draws ``figure`` for the slider values.
 DrawFunction = Callable[..., None]
@@ -141,6 +158,46 @@ def pin_axis_labels(figure: Figure) -> None:
             if label.get_text():
                 display = label.get_transform().transform(label.get_position())
                 axis.set_label_coords(*ax.transAxes.inverted().transform(display))
+
+
+def set_ylim_in_steps(ax: Axes, low: float, high: float, step: float) -> None:
+    """Give ``ax`` y limits holding ``[low, high]``, rounded outward to multiples of ``step``.
+
+    Limits that change only in steps keep the axis (ticks, tick labels) as it was for
+    most slider moves, so the explorer repaints only the data
+    (:class:`~lqe_helpers.explorers._layers.LayeredCanvas`); the limits are set only
+    if they differ from the current ones.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes.
+    low, high : float
+        Data range that must be visible, ``low <= high``, in the axis' units.
+    step : float
+        Rounding step, > 0, same units.
+    """
+    step = validation.positive("step", step)
+    limits = (step * math.floor(low / step), step * math.ceil(high / step))
+    if limits[0] == limits[1]:
+        limits = (limits[0] - step, limits[1] + step)
+    if tuple(ax.get_ylim()) != limits:
+        ax.set_ylim(*limits)
+
+
+def encode_png(rgba: np.ndarray, dpi: float) -> bytes:
+    """The picture ``rgba`` (uint8, shape (h, w, 4)) as PNG bytes, fast rather than small.
+
+    zlib's fastest level: for a widget on the same machine encoding time matters
+    more than bytes (``benchmarks/bench_widgets.py`` measures the levels). An opaque
+    picture is stored as RGB, a quarter fewer bytes to compress. No metadata besides
+    the resolution, so equal pictures give equal bytes.
+    """
+    opaque = bool(rgba[..., 3].min() == 255)
+    image = Image.fromarray(np.ascontiguousarray(rgba[..., :3] if opaque else rgba))
+    buffer = io.BytesIO()
+    image.save(buffer, format="png", compress_level=PNG_COMPRESS_LEVEL, dpi=(dpi, dpi))
+    return buffer.getvalue()
 
 
 def _check_readout_format(readout_format: str) -> None:
@@ -300,19 +357,25 @@ class Explorer:
         Figure size in inches; with ``dpi`` it fixes the image's height on the page.
     dpi : int
         Resolution of the rendered PNG.
+    describe : callable, optional
+        ``describe(**values) -> str``: one or two sentences saying what the figure
+        shows at those slider values (the static picture's alt text,
+        :attr:`description`); default the title.
     """
 
     def __init__(self, title: str, sliders: Mapping[str, widgets.ValueWidget],
                  draw: DrawFunction, figsize: tuple[float, float] = (9.0, 4.0),
-                 dpi: int = 90) -> None:
+                 dpi: int = 90, describe: Callable[..., str] | None = None) -> None:
         if not sliders:
             raise ValueError("sliders must name at least one slider, got none")
         self.title = title
         self.sliders = dict(sliders)
         self.draw = draw
+        self.describe = describe
         self.dpi = dpi
         self.figure = Figure(figsize=figsize, dpi=dpi)
         FigureCanvasAgg(self.figure)
+        self.layers = LayeredCanvas(self.figure)
         width, height = (round(size * dpi) for size in figsize)
         self.image = widgets.Image(
             format="png",
@@ -335,14 +398,26 @@ class Explorer:
         """Current slider values, by the keyword names ``draw`` receives."""
         return {name: slider.value for name, slider in self.sliders.items()}
 
+    @property
+    def description(self) -> str:
+        """One or two sentences saying what the figure shows at the current values.
+
+        The alt text of the static picture (:meth:`static_html`); the title when the
+        explorer was made without a ``describe`` function.
+        """
+        if self.describe is None:
+            return self.title
+        return self.describe(**self.values)
+
     def redraw(self) -> None:
-        """Draw the figure for the current values and show it."""
+        """Draw the figure for the current values and show it.
+
+        Only the artists the drawing changed are painted again, over a cached picture
+        of the rest (:class:`~lqe_helpers.explorers._layers.LayeredCanvas`); the
+        picture is the same as a full rendering.
+        """
         self.draw(self.figure, **self.values)
-        buffer = io.BytesIO()
-        # Fast zlib level: encoding time matters more than bytes for a local widget.
-        self.figure.savefig(buffer, format="png", dpi=self.dpi, metadata={"Software": None},
-                            pil_kwargs={"compress_level": 1})
-        self.png = buffer.getvalue()
+        self.png = encode_png(self.layers.render(), self.dpi)
         self.image.value = self.png
 
     def _on_change(self, change: Mapping[str, object]) -> None:
@@ -361,7 +436,7 @@ class Explorer:
             for slider in self.sliders.values())
         at = f"its default values: {shown}" if self.values == self.defaults else shown
         return (
-            f'<figure class="lqe-explorer"><img alt="{html.escape(self.title)}" '
+            f'<figure class="lqe-explorer"><img alt="{html.escape(self.description)}" '
             f'src="data:image/png;base64,{encoded}"/>'
             f"<figcaption><em>{html.escape(self.title)}, shown at {html.escape(at)}. "
             f"Open the notebook in JupyterLab to move the sliders."

@@ -96,8 +96,7 @@ def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
     ndarray, shape (m, 3)
         One row ``[1, 0, 0]`` per sensor.
     """
-    _check_sensors(sensors)
-    return np.tile([1.0, 0.0, 0.0], (len(sensors), 1))
+    return np.tile([1.0, 0.0, 0.0], (len(sensor_names(sensors)), 1))
 
 
 def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -145,13 +144,36 @@ def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarr
     return variance[..., None, None] * np.eye(size)
 
 
-def _check_sensors(sensors: Sequence[str]) -> None:
-    if isinstance(sensors, str) or len(sensors) == 0:
+def sensor_names(sensors: Sequence[str]) -> tuple[str, ...]:
+    """Check a choice of sensors and return it as a tuple of names.
+
+    Parameters
+    ----------
+    sensors : sequence of str
+        Distinct names from :data:`SENSORS` in row order, e.g. ``("vision",)``.
+
+    Returns
+    -------
+    tuple of str
+
+    Raises
+    ------
+    ValueError
+        If ``sensors`` is a single string (``"vision"`` instead of ``("vision",)``),
+        not a sequence at all (``None``), empty, or holds unknown or repeated names.
+    """
+    wanted = f"a non-empty sequence of names from {SENSORS}, e.g. ('vision',)"
+    if isinstance(sensors, (str, bytes)):
         raise ValueError(
-            f"sensors must be a non-empty sequence of names from {SENSORS}, got {sensors!r}"
-        )
-    unknown = [s for s in sensors if s not in SENSORS]
-    if unknown or len(set(sensors)) != len(sensors):
-        raise ValueError(
-            f"sensors must be distinct names from {SENSORS}, got {tuple(sensors)!r}"
-        )
+            f"sensors must be {wanted}, got the string {sensors!r}: write "
+            f"({sensors!r},) with the comma for one sensor")
+    try:
+        names = tuple(sensors)
+    except TypeError:
+        raise ValueError(f"sensors must be {wanted}, got {sensors!r}") from None
+    if len(names) == 0:
+        raise ValueError(f"sensors must be {wanted}, got {sensors!r}")
+    known = all(isinstance(s, str) and s in SENSORS for s in names)
+    if not known or len(set(names)) != len(names):
+        raise ValueError(f"sensors must be distinct names from {SENSORS}, got {names!r}")
+    return names

@@ -6,6 +6,7 @@ Nothing here runs on import. A notebook opts in with :func:`use_pack_style`.
 from __future__ import annotations
 
 import base64
+import html
 import io
 
 import matplotlib as mpl
@@ -87,13 +88,57 @@ def figure_png(figure: Figure) -> bytes:
     return buffer.getvalue()
 
 
+def figure_bundle(figure: Figure, description: str) -> tuple[dict[str, str], dict[str, dict]]:
+    """The display bundle and metadata that show ``figure`` described by ``description``.
+
+    Three forms of the one figure, so every reader gets the description:
+
+    - ``text/html``: ``<img src="data:image/png;base64,…" alt="description">``, what
+      JupyterLab shows (its own PNG renderer writes no ``alt``, so a screen reader
+      would meet an unlabelled image) and what the handouts show;
+    - ``image/png`` with ``metadata["image/png"]["alt"] = description``, for tools that
+      want the picture itself (PDF export, nbconvert's other templates);
+    - ``text/plain``: the description, for a reader (or a test) with text only.
+
+    Parameters
+    ----------
+    figure : matplotlib.figure.Figure
+        The figure (left open).
+    description : str
+        What the figure shows, in words: one or two sentences, not empty.
+
+    Returns
+    -------
+    data : dict of str to str
+        The bundle by mimetype (the PNG base64-encoded, as in a notebook file).
+    metadata : dict of str to dict
+        ``{"image/png": {"alt": description}}``.
+
+    Raises
+    ------
+    ValueError
+        If ``description`` is not a string with some text in it.
+    """
+    if not isinstance(description, str) or not description.strip():
+        raise ValueError(f"description must be a non-empty sentence, got {description!r}")
+    text = description.strip()
+    png = base64.b64encode(figure_png(figure)).decode("ascii")
+    data = {
+        "text/html": f'<img src="data:image/png;base64,{png}" alt="{html.escape(text)}">',
+        "image/png": png,
+        "text/plain": text,
+    }
+    return data, {"image/png": {"alt": text}}
+
+
 def show_figure(figure: Figure, description: str) -> None:
     """Display ``figure`` as a static PNG described by ``description``, then close it.
 
     The description is the figure's alt text: one or two sentences saying what the
-    figure shows, written beside the figure in the notebook. It travels with the
-    output (``metadata["image/png"]["alt"]``, read by the handouts) and is the
-    output's plain-text form, so a reader without the picture still gets it.
+    figure shows, written beside the figure in the notebook (e.g. "Position against
+    time, 0–10 s: true path, noisy vision at σ_v = 1.5 cm, filtered estimate with its
+    ±2σ band"). It reaches JupyterLab's screen-reader users (the ``<img alt>`` of the
+    ``text/html`` form), the handouts and plain-text readers: see :func:`figure_bundle`.
 
     Parameters
     ----------
@@ -101,15 +146,14 @@ def show_figure(figure: Figure, description: str) -> None:
         The figure to show; it is closed afterwards, so it is not drawn twice.
     description : str
         What the figure shows, in words (not empty).
+
+    Raises
+    ------
+    ValueError
+        If ``description`` is empty (the figure is then left open, nothing is shown).
     """
     from IPython.display import display
 
-    if not isinstance(description, str) or not description.strip():
-        raise ValueError(f"description must be a non-empty sentence, got {description!r}")
-    png = figure_png(figure)
+    data, metadata = figure_bundle(figure, description)
     plt.close(figure)
-    display(
-        {"image/png": base64.b64encode(png).decode("ascii"), "text/plain": description.strip()},
-        raw=True,
-        metadata={"image/png": {"alt": description.strip()}},
-    )
+    display(data, raw=True, metadata=metadata)

@@ -3,14 +3,11 @@
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
 
 import numpy as np
 
 from . import validation
-
-if TYPE_CHECKING:
-    from .scenario import Scenario
+from .scenario import Scenario
 
 
 def predict_ahead(estimates: np.ndarray, A: np.ndarray, steps: int) -> np.ndarray:
@@ -92,8 +89,9 @@ class OpenLoop:
         Time since the last measurement (s).
     means : ndarray, shape (steps + 1, 3)
         ``A^k ẑ``: where the observer expects the butterfly (cm, cm/s, cm/s²).
-    covariances : ndarray, shape (steps + 1, 3, 3)
-        ``P(k)`` from ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)).
+    covariances : ndarray, shape (..., steps + 1, 3, 3)
+        ``P(k)`` from ``P(k+1) = A P(k) Aᵀ + Q`` (Lesson 0.5 eq. (9)); leading axes
+        are those of the starting covariance given to :func:`open_loop`.
     """
 
     times: np.ndarray
@@ -102,8 +100,8 @@ class OpenLoop:
 
     @property
     def position_stds(self) -> np.ndarray:
-        """Standard deviation of the predicted position (cm), shape (steps + 1,)."""
-        return np.sqrt(self.covariances[:, 0, 0])
+        """Standard deviation of the predicted position (cm), shape (..., steps + 1)."""
+        return np.sqrt(self.covariances[..., 0, 0])
 
 
 def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
@@ -119,18 +117,22 @@ def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
         Supplies Δt, A and Q (through its σ_j).
     estimate : array_like, shape (3,)
         Estimate ``[p, v, a]`` when the measurements stop.
-    covariance : array_like, shape (3, 3)
+    covariance : array_like, shape (..., 3, 3)
         Its covariance, e.g. the filter's ``estimate_covariances`` at that time, or
-        zeros for a perfectly known start.
+        zeros for a perfectly known start; leading axes give a batch of predictions
+        (e.g. one per σ of a sweep) sharing the same mean.
     duration : float
         Prediction horizon in s, > 0 and a whole number of the scenario's time steps.
     """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     estimate = validation.finite_array("estimate", estimate, min_ndim=1)
     if estimate.shape != (3,):
         raise ValueError(f"estimate must have shape (3,), got shape {estimate.shape}")
-    duration = validation.positive("duration", duration, "s")
+    validation.positive("duration", duration, "s")
+    # The value as given, so that a float32 duration is judged at float32 precision.
     steps = validation.whole_steps("duration", duration, scenario.dt)
     covariances = propagate_covariance(covariance, scenario.A, scenario.Q, steps)
+    # (..., steps + 1, 3, 3) for a (..., 3, 3) start: P(0) … P(steps) along axis -3.
     means = np.empty((steps + 1, 3))
     means[0] = estimate
     for k in range(steps):
@@ -144,7 +146,7 @@ def amplitude_crossing(loop: OpenLoop, amplitude: float) -> float | None:
     Parameters
     ----------
     loop : OpenLoop
-        A prediction from :func:`open_loop`.
+        A prediction from :func:`open_loop` started from one covariance (3, 3).
     amplitude : float
         Threshold in cm, > 0 (e.g. the path's amplitude A).
 
@@ -156,6 +158,12 @@ def amplitude_crossing(loop: OpenLoop, amplitude: float) -> float | None:
     """
     if not isinstance(loop, OpenLoop):
         raise ValueError(f"loop must be an OpenLoop from open_loop(), got {type(loop).__name__}")
+    if loop.covariances.ndim != 3:
+        raise ValueError(
+            f"loop must hold one prediction (covariances of shape (steps + 1, 3, 3)), got "
+            f"a batch with covariances of shape {loop.covariances.shape}; call open_loop "
+            f"with one covariance (3, 3) per crossing time wanted"
+        )
     amplitude = validation.positive("amplitude", amplitude, "cm")
     above = 2 * loop.position_stds >= amplitude
     return float(loop.times[np.argmax(above)]) if above.any() else None

@@ -144,11 +144,12 @@ class Scenario:
         Raises ``ValueError`` unless ``0 <= delay < duration`` and ``delay`` is a
         whole multiple of :attr:`dt`.
         """
-        delay = validation.non_negative("delay", delay, "s")
+        seconds = validation.non_negative("delay", delay, "s")
+        # The value as given, so that a float32 delay is judged at float32 precision.
         steps = validation.whole_steps("delay", delay, self.dt)
         if steps >= self.n_steps:
             raise ValueError(
-                f"delay must be shorter than the trial ({self.duration} s), got {delay} s"
+                f"delay must be shorter than the trial ({self.duration} s), got {seconds} s"
             )
         return steps
 
@@ -196,7 +197,7 @@ class Scenario:
         vision's noise is identical in vision-only and fused simulations, and run 0
         of a Monte Carlo batch is the single run shown in the figures.
         """
-        model.observation_matrix(sensors)  # validates the names
+        sensors = model.sensor_names(sensors)
         rng = np.random.default_rng(self.seed)
         noise = simulation.unit_noise(rng, self.n_steps, len(model.SENSORS), runs=runs)
         return noise[..., [model.SENSORS.index(s) for s in sensors]]

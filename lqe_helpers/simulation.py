@@ -126,6 +126,8 @@ def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
     if signal.ndim == 0:
         raise ValueError(f"signal must have a time axis, got a scalar {signal.item()!r}")
     try:
+        if isinstance(axis, bool) or not isinstance(axis, (int, np.integer)):
+            raise IndexError
         n_steps = signal.shape[axis]
     except IndexError:
         raise ValueError(

@@ -64,8 +64,9 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
     Raises
     ------
     ValueError
-        If the inputs are invalid; if P overflows, so no finite fixed point exists (C
-        cannot see an unstable mode of A, or Q does not drive it); or if
+        If the inputs are invalid; if (A, C) is not detectable (C cannot see a mode of
+        A that does not decay, such as the position when only the velocity is measured:
+        see :func:`undetectable_modes`); if P overflows all the same; or if
         ``max_doublings`` steps end before the relative change of P falls to ``rtol``.
     """
     A = validation.square_matrix("A", A)
@@ -82,6 +83,17 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
     R = validation.covariance("R", R, size=m, definite=True)
     max_doublings = validation.count("max_doublings", max_doublings, minimum=1)
     rtol = validation.positive("rtol", rtol)
+    directions, eigenvalues = undetectable_modes(A, C)
+    if directions.shape[1]:
+        shown = np.round(directions.T, 6) + 0.0  # + 0.0 turns -0.0 into 0.0
+        eigenvalues = np.round(eigenvalues, 6) + 0.0
+        raise ValueError(
+            f"(A, C) must be detectable (C must observe every mode of A that does not "
+            f"decay), got C = {C.tolist()}, which cannot see the state direction(s) "
+            f"{shown.tolist()}, on which A has eigenvalue(s) {eigenvalues.tolist()} of "
+            f"modulus >= 1: the error of the estimate there never shrinks, so the filter "
+            f"has no steady state; add a sensor that reads those states"
+        )
 
     batch = R.shape[:-2]
     identity = np.eye(k)
@@ -99,6 +111,8 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
             H_next = 0.5 * (H_next + H_next.mT)
         if not np.all(np.isfinite(H_next)):
             raise ValueError(
+                # Not expected once (A, C) is detectable; kept so that a numerical
+                # breakdown is reported, never returned as a steady state.
                 f"the Riccati recursion has no finite fixed point for these A, C, Q and R "
                 f"(P overflowed at doubling step {doubling}): C must observe, and Q must "
                 f"drive, every mode of A that does not decay"
@@ -116,3 +130,63 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
         f"relative change of P was {change:.3g}; allow more doubling steps (the default "
         f"is 200) or a larger rtol"
     )
+
+
+#: Rank tolerance of the observability matrix, relative to its largest singular value.
+OBSERVABILITY_RTOL = 1e-12
+#: Modes of A with |λ| > 1 − this count as not decaying (a decay time of 10⁶ steps or
+#: more). The margin also absorbs the rounding of repeated eigenvalues such as the
+#: triple eigenvalue 1 of the constant-acceleration model.
+DECAY_MARGIN = 1e-6
+
+
+def undetectable_modes(A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The part of the state that C never sees, if A does not make it decay.
+
+    (A, C) is detectable when every mode of A with ``|λ| >= 1`` is observable
+    (Popov–Belevitch–Hautus test: ``[A − λI; C]`` has full column rank for those λ).
+    Here the unobservable subspace ``N``, the null space of the observability matrix
+    ``[C; C A; …; C A^{k−1}]``, is computed by SVD (rank tolerance
+    :data:`OBSERVABILITY_RTOL` of the largest singular value). N is invariant under A
+    and the eigenvalues of A restricted to N are exactly its unobservable modes, so
+    (A, C) is detectable when all of them satisfy ``|λ| <= 1 −`` :data:`DECAY_MARGIN`.
+
+    Parameters
+    ----------
+    A : ndarray, shape (k, k)
+        Transition matrix, already validated.
+    C : ndarray, shape (m, k)
+        Observation matrix, already validated.
+
+    Returns
+    -------
+    directions : ndarray, shape (k, d)
+        A basis of N in reduced echelon form (each column 1 at its own pivot state and 0
+        at the others' pivots, so ``[1, 0, 0]`` reads "the position"); d = 0 when (A, C)
+        is detectable.
+    eigenvalues : ndarray, shape (e,)
+        The eigenvalues of A on N with ``|λ| > 1 −`` :data:`DECAY_MARGIN`, 1 <= e <= d
+        (e = 0 when (A, C) is detectable).
+    """
+    k = A.shape[0]
+    blocks, block = [], C
+    for _ in range(k):
+        blocks.append(block)
+        block = block @ A
+    _, singular, vt = np.linalg.svd(np.vstack(blocks))
+    largest = singular[0] if singular.size else 0.0
+    rank = int(np.sum(singular > OBSERVABILITY_RTOL * largest)) if largest > 0 else 0
+    unobservable = vt[rank:].T                                       # (k, d)
+    eigenvalues = np.linalg.eigvals(unobservable.T @ A @ unobservable)
+    slow = eigenvalues[np.abs(eigenvalues) > 1.0 - DECAY_MARGIN]
+    if slow.size == 0:
+        return np.zeros((k, 0)), np.zeros(0)
+    # Reduced echelon form: greedily pick the states that make the basis independent.
+    pivots: list[int] = []
+    for state in range(k):
+        trial = unobservable[[*pivots, state]]
+        if np.linalg.matrix_rank(trial, tol=1e-9) == len(pivots) + 1:
+            pivots.append(state)
+    echelon = np.linalg.solve(unobservable[pivots].T, unobservable.T).T
+    echelon[np.abs(echelon) < 1e-12] = 0.0
+    return echelon, slow.real if np.all(slow.imag == 0) else slow

@@ -6,6 +6,7 @@ received and what is allowed, e.g. ``"sigma_v must be > 0 cm, got -1.5"``.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -22,13 +23,64 @@ def _describe(value: object) -> str:
     return f"an array of shape {array.shape}"
 
 
+#: What each non-numeric dtype kind is called in messages.
+_NOT_REAL_KINDS = {"b": "a boolean (True/False is not a number here)",
+                   "c": "a complex number (the imaginary part would be lost)",
+                   "U": "text (write the number without quotes)",
+                   "S": "text (write the number without quotes)",
+                   "M": "a date", "m": "a time interval (give plain seconds)"}
+
+
+def _not_real(value: object) -> str | None:
+    """Why ``value`` is not real numeric data (a phrase for the message), else None.
+
+    Booleans, complex numbers and text convert silently to float in numpy (True is 1,
+    ``1+2j`` loses its imaginary part, ``"0.01"`` parses), so they are refused here,
+    inside lists and tuples and in numpy arrays of any dtype, before any conversion.
+    """
+    if isinstance(value, (str, bytes)):
+        return _NOT_REAL_KINDS["U"]
+    if isinstance(value, (bool, np.bool_)):
+        return _NOT_REAL_KINDS["b"]
+    if isinstance(value, (complex, np.complexfloating)):
+        return _NOT_REAL_KINDS["c"]
+    if isinstance(value, (list, tuple)):
+        for item in value:
+            reason = _not_real(item)
+            if reason is not None:
+                return reason
+        return None
+    if isinstance(value, np.ndarray):
+        if value.dtype.kind == "O":
+            for item in value.flat:
+                reason = _not_real(item)
+                if reason is not None:
+                    return reason
+            return None
+        return _NOT_REAL_KINDS.get(value.dtype.kind)
+    if isinstance(value, (int, float, np.number)):
+        return None
+    try:  # anything else numpy can read (a pandas Series, a memoryview, ...)
+        kind = np.asarray(value).dtype.kind
+    except (TypeError, ValueError):
+        return None
+    return _NOT_REAL_KINDS.get(kind)  # None for objects: the float conversion decides
+
+
 def _number(name: str, value: object, requirement: str, unit_text: str,
             allowed: Callable[[float], bool], non_numeric: str = "a number") -> float:
     """``value`` as a finite float for which ``allowed`` holds, else a ``ValueError``.
 
     The message says "``name`` must be a finite number``requirement````unit_text``" and
-    quotes ``value``; a value that is not a number at all is called ``non_numeric``.
+    quotes ``value``; a value that is not a number at all (text, a boolean, a complex
+    number, an array, None) is called ``non_numeric`` and the message says what it is.
     """
+    reason = _not_real(value)
+    if reason is None and np.ndim(value) != 0:
+        reason = "an array (give a single number)"
+    if reason is not None:
+        raise ValueError(
+            f"{name} must be {non_numeric}{requirement}{unit_text}, got {value!r}: {reason}")
     try:
         number = float(value)
     except (TypeError, ValueError):
@@ -50,6 +102,16 @@ def non_negative(name: str, value: float, unit: str = "") -> float:
     return _number(name, value, " >= 0", f" {unit}" if unit else "", lambda x: x >= 0)
 
 
+def instance(name: str, value: object, kind: type, example: str) -> object:
+    """Return ``value`` if it is a ``kind``, else a ``ValueError`` quoting ``example``."""
+    if not isinstance(value, kind):
+        text = repr(value)
+        text = text if len(text) <= 60 else f"{text[:50]} …"
+        raise ValueError(
+            f"{name} must be a {kind.__name__} ({example}), got {type(value).__name__} {text}")
+    return value
+
+
 def count(name: str, value: int, minimum: int = 0, maximum: int | None = None) -> int:
     """Return ``value`` if it is a whole number in ``[minimum, maximum]``."""
     allowed = f">= {minimum}" if maximum is None else f"in [{minimum}, {maximum}]"
@@ -69,34 +131,68 @@ def finite_number(name: str, value: float, unit: str = "") -> float:
 def whole_steps(name: str, value: float, dt: float) -> int:
     """A time ``value`` (s) as a whole number of time steps ``dt`` (s).
 
-    ``value / dt`` must be a whole number up to floating-point rounding (a relative
-    tolerance of 1e-9), so that ``0.1 / 0.01`` counts as 10 steps but ``0.004 / 0.01``
-    is refused rather than silently rounded to 0 steps. Callers check the sign of
-    ``value`` themselves; ``dt`` must be > 0.
+    ``value / dt`` must be a whole number up to the rounding of the numbers given: a
+    relative tolerance of 1e-9, or four units of the coarser precision of the two
+    inputs if that is larger (a float32 ``0.1`` is 0.10000000149 s, which is 10 steps
+    of 0.01 s to float32 precision). ``0.004 / 0.01`` is refused rather than silently
+    rounded to 0 steps. Callers check the sign of ``value`` themselves; ``dt`` must be
+    > 0.
     """
+    rtol = max(1e-9, 4.0 * max(_resolution(value), _resolution(dt)))
+    given = value  # quoted as given: np.float32(0.104) prints as 0.104
     value = finite_number(name, value, "s")
     dt = positive("dt", dt, "s")
     ratio = value / dt
     steps = round(ratio)
-    if abs(ratio - steps) > 1e-9 * max(1.0, abs(ratio)):
+    if abs(ratio - steps) > rtol * max(1.0, abs(ratio)):
         raise ValueError(
-            f"{name} must be a whole number of time steps dt = {dt} s, got {value} s "
-            f"({ratio:.6g} steps)"
+            f"{name} must be a whole number of time steps dt = {dt} s, got {given!s} s "
+            f"({ratio:.10g} steps), the nearest whole numbers of steps "
+            f"being {math.floor(ratio) * dt:.10g} s and {math.ceil(ratio) * dt:.10g} s"
         )
     return steps
 
 
+def _resolution(value: object) -> float:
+    """Relative precision (machine epsilon) of a number's type: float32 1.2e-7, else 2.2e-16."""
+    dtype = getattr(value, "dtype", None)
+    if dtype is not None and np.issubdtype(dtype, np.floating):
+        return float(np.finfo(dtype).eps)
+    return float(np.finfo(float).eps)
+
+
 def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
-    """Return ``value`` as a float array with at least ``min_ndim`` axes; NaN/inf allowed."""
+    """Return ``value`` as a float array with at least ``min_ndim`` axes; NaN/inf allowed.
+
+    Refused: text, booleans and complex numbers (numpy would convert them silently, see
+    :func:`_not_real`), anything that is not a rectangular array of numbers, and an
+    empty array (nothing to compute with: ``[]`` where a number or a list is meant).
+    """
+    reason = _not_real(value)
+    if reason is not None:
+        raise ValueError(
+            f"{name} must be a numeric array, got {_describe_raw(value)}: "
+            f"{reason}")
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a numeric array, got {value!r}") from None
+        raise ValueError(
+            f"{name} must be a numeric array, got {_describe_raw(value)}") from None
+    if array.size == 0:
+        raise ValueError(
+            f"{name} must hold at least one number, got an empty array of shape {array.shape}")
     if array.ndim < min_ndim:
         raise ValueError(
-            f"{name} must have at least {min_ndim} axes, got shape {array.shape}"
+            f"{name} must have at least {min_ndim} axes, got shape {array.shape} "
+            f"({_describe(array)})"
         )
     return array
+
+
+def _describe_raw(value: object) -> str:
+    """``repr`` of a value that may not convert to an array, shortened if long."""
+    text = repr(value)
+    return text if len(text) <= 80 else f"{text[:60]} … (a {type(value).__name__})"
 
 
 def finite_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:

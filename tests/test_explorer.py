@@ -5,7 +5,9 @@ from __future__ import annotations
 import base64
 import dataclasses
 import gc
+import html
 import importlib
+import io
 import weakref
 from typing import NamedTuple
 
@@ -17,14 +19,17 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.text import Text
+from PIL import Image
 
 from lqe_helpers.explorer import (
     Explorer,
+    encode_png,
     float_slider,
     log_slider,
     pin_axis_labels,
     reuse_panels,
 )
+from lqe_helpers.explorers._layers import LayeredCanvas
 from lqe_helpers.scenario import DEFAULT
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -332,3 +337,117 @@ def test_every_explorer_keeps_its_panels_until_the_scenario_changes(module, name
     draw(fresh, scenario=other, **values)
     assert png(figure, dpi=40) == png(fresh, dpi=40)
 
+
+
+# Fast redraws: only the changed artists are repainted, and the picture is the same.
+
+#: (module, factory) of every explorer in the pack.
+FACTORIES = [
+    ("background", "explore_background"),
+    ("vision", "explore_vision"),
+    ("initial_covariance", "explore_initial_covariance"),
+    ("fusion", "explore_fusion"),
+    ("noisier_proprioception", "explore_noisier_proprioception"),
+    ("delay", "explore_delay"),
+    ("bias", "explore_bias"),
+]
+
+
+def _slider_cases() -> list[tuple[str, str, str]]:
+    cases = []
+    for module, factory in FACTORIES:
+        explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
+        cases.extend((module, factory, name) for name in explorer.sliders)
+    return cases
+
+
+def _positions(slider) -> list[float]:
+    """Slider values on its grid: a quarter along, both ends, three quarters along, then
+    the low end, then one, two and one step above it (neighbours: the axes stay put)."""
+    logarithmic = hasattr(slider, "base")
+    values = []
+    for fraction in (0.25, 1.0, 0.75, 0.0):
+        exponent = slider.min + fraction * (slider.max - slider.min)
+        exponent = slider.min + slider.step * round((exponent - slider.min) / slider.step)
+        values.append(float(slider.base**exponent) if logarithmic else float(exponent))
+    for steps in (1, 2, 1):
+        up = slider.min + steps * slider.step
+        values.append(float(slider.base**up) if logarithmic else float(up))
+    return values
+
+
+def _full_rendering(explorer: Explorer) -> np.ndarray:
+    """RGB pixels of the explorer's drawing at its current values on a brand-new figure."""
+    figure = Figure(figsize=explorer.figure.get_size_inches(), dpi=explorer.dpi)
+    FigureCanvasAgg(figure)
+    explorer.draw(figure, **explorer.values)
+    figure.canvas.draw()
+    return np.asarray(figure.canvas.buffer_rgba())[..., :3]
+
+
+@pytest.mark.parametrize(("module", "factory", "name"), _slider_cases(),
+                         ids=[f"{m}-{n}" for m, _, n in _slider_cases()])
+def test_fast_redraw_equals_a_fresh_full_drawing(module, factory, name):
+    explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
+    slider = explorer.sliders[name]
+    for value in _positions(slider):
+        slider.value = value
+        shown = np.asarray(Image.open(io.BytesIO(explorer.png)))
+        expected = _full_rendering(explorer)
+        assert shown.shape == expected.shape
+        differing = int(np.any(shown != expected, axis=-1).sum())
+        assert differing == 0, f"{module} {name} = {value}: {differing} pixels differ"
+    # The last moves (between neighbours) took the fast path.
+    assert explorer.layers.fast_renders >= 1, (explorer.layers.full_renders,
+                                               explorer.layers.fast_renders)
+
+
+def test_fast_path_repaints_only_changed_artists_and_detects_other_changes():
+    explorer = make_explorer()
+    explorer.sliders["slope"].value = 2.0  # builds the cached layer
+    explorer.sliders["slope"].value = 3.0
+    assert explorer.layers.fast_renders == 0  # draw_line clears the figure: all new artists
+    figure = Figure(figsize=(4.0, 3.0), dpi=50)
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot()
+    (moving,) = ax.plot([0.0, 1.0], [0.0, 1.0])
+    ax.set_ylim(0.0, 5.0)
+    layers = LayeredCanvas(figure)
+    layers.render()
+    for slope, full, fast in ((2.0, 2, 0), (3.0, 2, 1), (4.0, 2, 2)):
+        moving.set_ydata([0.0, slope])
+        pixels = layers.render().copy()
+        assert (layers.full_renders, layers.fast_renders) == (full, fast)
+        figure.canvas.draw()
+        np.testing.assert_array_equal(pixels, np.asarray(figure.canvas.buffer_rgba()))
+    ax.set_ylim(0.0, 6.0)  # another axis range: repaint everything
+    moving.set_ydata([0.0, 1.0])
+    pixels = layers.render().copy()
+    assert layers.full_renders == 3
+    figure.canvas.draw()
+    np.testing.assert_array_equal(pixels, np.asarray(figure.canvas.buffer_rgba()))
+    ax.set_title("a static title, changed")  # a new text drawn after the line
+    pixels = layers.render().copy()
+    figure.canvas.draw()
+    np.testing.assert_array_equal(pixels, np.asarray(figure.canvas.buffer_rgba()))
+
+
+def test_png_encoding_keeps_every_pixel():
+    rng = np.random.default_rng(12)
+    opaque = rng.integers(0, 256, (7, 5, 4), dtype=np.uint8)
+    opaque[..., 3] = 255
+    translucent = rng.integers(0, 256, (7, 5, 4), dtype=np.uint8)
+    for rgba in (opaque, translucent):
+        decoded = np.asarray(Image.open(io.BytesIO(encode_png(rgba, 90))).convert("RGBA"))
+        np.testing.assert_array_equal(decoded, rgba)
+
+
+@pytest.mark.parametrize(("module", "factory"), FACTORIES, ids=[f[0] for f in FACTORIES])
+def test_static_picture_describes_the_current_view(module, factory):
+    explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
+    description = explorer.description
+    assert description != explorer.title and len(description.split()) >= 8
+    assert f'alt="{html.escape(description)}"' in explorer.static_html()
+    slider = next(iter(explorer.sliders.values()))
+    slider.value = _positions(slider)[1]
+    assert explorer.description != description  # it says which value is shown

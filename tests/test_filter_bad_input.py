@@ -22,7 +22,8 @@ GOOD = {
     ("change", "message"),
     [
         ({"y": np.zeros(10)}, r"y must have at least 2 axes, got shape \(10,\)"),
-        ({"y": np.zeros((0, 1))}, r"y must hold at least one time step, got shape \(0, 1\)"),
+        ({"y": np.zeros((0, 1))},
+         r"y must hold at least one number, got an empty array of shape \(0, 1\)"),
         ({"y": np.array([[1.0], [np.nan]])}, "y must contain only finite numbers, got 1 NaN"),
         ({"y": np.array([[1.0], [np.inf]])}, "y must contain only finite numbers"),
         ({"A": np.eye(3)[:2]}, r"A must have trailing shape \(n, n\), got shape \(2, 3\)"),

@@ -9,6 +9,7 @@ can fail.
 from __future__ import annotations
 
 import base64
+import errno
 import hashlib
 import re
 from collections import Counter
@@ -21,7 +22,8 @@ import soupsieve
 from bs4 import BeautifulSoup
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
-from lqe_helpers.authoring import handouts
+from lqe_helpers.authoring import files, handout_pages, handouts
+from lqe_helpers.authoring.files import MANIFEST_NAME, OutputFolderError, OutputWriteError
 from lqe_helpers.authoring.student_edition import EXPLORER_TAG
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
@@ -101,8 +103,13 @@ def squash(text: str) -> str:
     return " ".join(text.split())
 
 
+def local_mathjax(variant: str) -> str:
+    """The src of the local MathJax script on a page of ``variant`` ("" or "prose/")."""
+    return handout_pages.mathjax_url(variant.count("/"))
+
+
 def assert_offline(page: BeautifulSoup, mathjax_url: str) -> None:
-    """Figures embedded; the only remote resource is MathJax, loaded without blocking."""
+    """Figures embedded; the one script is the local MathJax ``mathjax_url``, async."""
     images = page.find_all("img")
     for image in images:
         assert image["src"].startswith("data:image/"), image["src"][:80]
@@ -273,14 +280,17 @@ def test_fixture_pages_and_layout(fixture_build):
     assert written == [out / "01_fixture.html", out / "02_fixture_again.html", out / "index.html",
                        out / "prose" / "01_fixture.html", out / "prose" / "02_fixture_again.html",
                        out / "prose" / "index.html"]
-    assert sorted(out.rglob("*")) == sorted([*written, out / "prose"])
+    mathjax = out / handout_pages.MATHJAX_DIR
+    assert mathjax.is_dir() and (mathjax / "MathJax.js").is_file()
+    rest = [path for path in out.rglob("*") if mathjax not in path.parents and path != mathjax]
+    assert sorted(rest) == sorted([*written, out / "prose", out / MANIFEST_NAME])
 
 
 @pytest.mark.parametrize("variant", ["", "prose/"])
 def test_fixture_page_content(fixture_build, variant):
     out, _ = fixture_build
     page = soup(out / variant / "01_fixture.html")
-    assert_offline(page, handouts.DEFAULT_MATHJAX_URL)
+    assert_offline(page, local_mathjax(variant))
     assert_no_error_or_widget(page)
     assert page.title.get_text() == "Fixture handout"
     text = squash(page.get_text())
@@ -390,29 +400,110 @@ def test_stderr_is_reported(tmp_path):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
 
 
-def test_bad_folders_are_refused(tmp_path):
+def test_bad_folders_are_refused_before_any_notebook_runs(tmp_path, monkeypatch):
     with pytest.raises(ValueError, match=r"at least one \.ipynb"):
         handouts.build_handouts(tmp_path, tmp_path / "out")
-    write_fixture(tmp_path / "src", cells=CELLS[:1])
-    with pytest.raises(ValueError, match="out_dir must differ"):
-        handouts.build_handouts(tmp_path / "src", tmp_path / "src")
+    source = tmp_path / "C" / "drafts"
+    write_fixture(source, cells=CELLS[:1])
+    (tmp_path / "file").write_text("a file")
+    before = snapshot(tmp_path)
+    monkeypatch.setattr(handouts, "execute_notebook", fail_if_called)
+    for out, message in [(source, "is the source folder"),
+                         (source / "pages", "lies inside the source folder"),
+                         (tmp_path / "C", "contains the source folder"),
+                         (tmp_path / "file", "is a file; give a folder")]:
+        with pytest.raises(OutputFolderError, match=message):
+            handouts.build_handouts(source, out)
+    assert snapshot(tmp_path) == before
 
 
-def test_stale_pages_are_removed_and_nothing_else(tmp_path):
-    write_fixture(tmp_path / "src", cells=CELLS[:1])
-    out = tmp_path / "out"
-    stale = [out / "00_renamed.html", out / "prose" / "00_renamed.html"]
-    kept = [out / "notes.txt", out / "prose" / "style.css", out / "extra" / "page.html",
-            out / "prose" / "extra" / "page.html", out / "00_renamed.ipynb"]
-    for path in [*stale, *kept]:
+def fail_if_called(*args, **kwargs):
+    raise AssertionError("a notebook was executed although the output folder was refused")
+
+
+def snapshot(folder: Path) -> dict[str, bytes | str]:
+    """Every file (its bytes), link (its target) and folder under ``folder``."""
+    return {path.relative_to(folder).as_posix():
+            (f"link -> {path.readlink()}" if path.is_symlink()
+             else "folder" if path.is_dir() else path.read_bytes())
+            for path in sorted(folder.rglob("*"))}
+
+
+def test_a_rebuild_replaces_only_its_own_pages(tmp_path):
+    """The issue's case: course_home.html kept, the stale page of a renamed notebook gone."""
+    source, out = tmp_path / "src", tmp_path / "out"
+    old = write_fixture(source, "00_renamed", cells=CELLS[:1])
+    handouts.build_handouts(source, out, mathjax_url="")
+    mine = {out / "course_home.html": "the instructor's own page",
+            out / "prose" / "style.css": "mine", out / "extra" / "page.html": "mine",
+            out / "00_renamed.ipynb": "mine"}
+    for path, text in mine.items():
         path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text("from before")
-    written = handouts.build_handouts(tmp_path / "src", out, mathjax_url="")
+        path.write_text(text)
+    old.rename(source / "01_fixture.ipynb")
+    written = handouts.build_handouts(source, out, mathjax_url="")
     assert [path.relative_to(out).as_posix() for path in written] == [
         "01_fixture.html", "index.html", "prose/01_fixture.html", "prose/index.html"]
-    assert not any(path.exists() for path in stale)
-    assert all(path.read_text() == "from before" for path in kept)
-    assert sorted(path for path in out.rglob("*") if path.is_file()) == sorted([*written, *kept])
+    assert all(path.read_text() == text for path, text in mine.items())
+    assert sorted(path for path in out.rglob("*") if path.is_file()) == sorted(
+        [*written, *mine, out / MANIFEST_NAME])  # both 00_renamed.html pages are gone
+
+
+def test_an_index_it_did_not_write_stops_the_build(tmp_path, monkeypatch):
+    """The issue's case: an instructor's index.html is never overwritten."""
+    write_fixture(tmp_path / "src", cells=CELLS[:1])
+    out = tmp_path / "out"
+    (out / "prose").mkdir(parents=True)
+    (out / "index.html").write_text("the instructor's index")
+    (out / "course_home.html").write_text("the instructor's own page")
+    before = snapshot(out)
+    monkeypatch.setattr(handouts, "execute_notebook", fail_if_called)
+    with pytest.raises(OutputFolderError, match=r"index\.html was not written by handouts"):
+        handouts.build_handouts(tmp_path / "src", out)
+    assert snapshot(out) == before
+
+
+def test_a_full_disk_while_writing_pages_changes_nothing(tmp_path, monkeypatch):
+    write_fixture(tmp_path / "src", cells=CELLS[:1])
+    out = tmp_path / "out"
+    handouts.build_handouts(tmp_path / "src", out, mathjax_url="")
+    (out / "course_home.html").write_text("mine")
+    before = snapshot(tmp_path)
+    real = files._write_fd
+    calls = []
+
+    def full_disk(fd: int, data: bytes) -> None:
+        calls.append(len(data))
+        if len(calls) == 3:  # the third page: half of it, then the disk is full
+            real(fd, data[:len(data) // 2])
+            raise OSError(errno.ENOSPC, "No space left on device")
+        real(fd, data)
+
+    monkeypatch.setattr(files, "_write_fd", full_disk)
+    with pytest.raises(OutputWriteError, match="No space left on device"):
+        handouts.build_handouts(tmp_path / "src", out, mathjax_url="x.js")
+    assert len(calls) == 3
+    assert snapshot(tmp_path) == before
+
+
+def test_names_with_spaces_and_accents_link_from_the_index(tmp_path):
+    source = tmp_path / "src"
+    names = ["01 first page", "02 café ΔΣ", "03 #hash?"]
+    for name in names:
+        write_fixture(source, name, cells=[new_markdown_cell(f"# Page {name}")])
+    out = tmp_path / "out"
+    written = handouts.build_handouts(source, out, mathjax_url="")
+    assert {path.name for path in written} == {f"{name}.html" for name in names} | {"index.html"}
+    for folder in (out, out / "prose"):
+        index = soup(folder / "index.html")
+        hrefs = [anchor["href"] for anchor in index.select("main a[href], body a[href]")
+                 if anchor["href"].endswith(".html") and "index" not in anchor["href"]]
+        assert hrefs == ["01%20first%20page.html", "02%20caf%C3%A9%20%CE%94%CE%A3.html",
+                         "03%20%23hash%3F.html"]
+        assert_local_links_resolve(index, folder)
+        # The pages' previous/next links too.
+        assert_local_links_resolve(soup(folder / "02 café ΔΣ.html"), folder)
+    assert handouts.Page("02 café ΔΣ", "t").href == "02%20caf%C3%A9%20%CE%94%CE%A3.html"
 
 
 def test_command_line(tmp_path, capsys):
@@ -424,18 +515,43 @@ def test_command_line(tmp_path, capsys):
         str(out / name) for name in ("01_fixture.html", "index.html", "prose/01_fixture.html",
                                      "prose/index.html")]
     write_fixture(tmp_path / "src", "02_broken", BROKEN)
+    before = snapshot(out)
     assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(out)]) == 1
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err.startswith(f"error: {tmp_path / 'src' / '02_broken.ipynb'} shows error "
-                                   "output(s): cell 2: ZeroDivisionError")
-    assert "return x / 0" in captured.err
+    [line] = captured.err.splitlines()
+    assert line.startswith(f"error: {tmp_path / 'src' / '02_broken.ipynb'} shows error "
+                           "output(s): cell 2: ZeroDivisionError: division by zero")
+    assert line.endswith(" (--verbose shows the rest)")
+    assert snapshot(out) == before
+    # --verbose adds the traceback, down to the line that raised.
+    assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(out),
+                          "--verbose"]) == 1
+    assert "return x / 0" in capsys.readouterr().err
     # Bad input: the same exit code and one "error:" line, no usage message.
     assert handouts.main(["--source", str(tmp_path / "missing"), "--out", str(out)]) == 1
     captured = capsys.readouterr()
     assert captured.out == ""
     assert captured.err == (f"error: source_dir must be an existing folder, got "
                             f"{tmp_path / 'missing'}\n")
+
+
+@pytest.mark.slow
+def test_a_cell_past_the_time_limit_is_one_error_line(tmp_path, capsys):
+    cells = [new_code_cell("import time\nwhile True:\n    time.sleep(0.1)")]
+    write_fixture(tmp_path / "src", "01_endless", cells)
+    assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(tmp_path / "out"),
+                          "--timeout", "2"]) == 1
+    [line] = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"error: {tmp_path / 'src' / '01_endless.ipynb'}: cell 0 (import "
+                           f"time) ran longer than the time limit of 2 s per cell (--timeout)")
+    assert not (tmp_path / "out").exists()
+
+
+def test_help_states_the_default_time_limit(capsys):
+    with pytest.raises(SystemExit):
+        handouts.main(["--help"])
+    assert "(default: 300)" in " ".join(capsys.readouterr().out.split())
 
 
 def test_exporter_never_picks_the_widget_view():
@@ -488,7 +604,7 @@ def test_every_notebook_has_both_pages_and_an_index(pack_build):
         assert [a["href"] for a in index.select("ol a")] == [f"{stem}.html" for stem in REAL]
         titles = [soup(out / variant / f"{stem}.html").title.get_text() for stem in REAL]
         assert [a.get_text() for a in index.select("ol a")] == titles
-        assert_offline(index, handouts.DEFAULT_MATHJAX_URL)
+        assert_offline(index, local_mathjax(variant))
         assert_local_links_resolve(index, out / variant)
 
 
@@ -498,7 +614,7 @@ def test_pack_page(pack_build, stem, variant):
     out, _ = pack_build
     page = soup(out / variant / f"{stem}.html")
     source = nbformat.read(NOTEBOOKS / f"{stem}.ipynb", as_version=4)
-    assert_offline(page, handouts.DEFAULT_MATHJAX_URL)
+    assert_offline(page, local_mathjax(variant))
     assert_no_error_or_widget(page)
     assert_local_links_resolve(page, out / variant)
 

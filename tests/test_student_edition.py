@@ -50,8 +50,10 @@ def fixture_notebook(*, with_solutions: bool = True) -> nbformat.NotebookNode:
     solution = new_code_cell(SOLUTION, metadata={"tags": ["solution"]}, execution_count=2,
                              outputs=[new_output("stream", name="stdout", text="MSE = 50.0 cm²\n")])
     second = new_code_cell(SECOND_SOLUTION, metadata={"tags": ["solution"]})
-    if not with_solutions:
+    if not with_solutions:  # nothing marked, and nothing that looks like a task either
         solution.metadata, second.metadata = {}, {}
+        for cell in (solution, second):
+            cell.source = cell.source.replace("# Task:", "# Worked example:")
     notebook = new_notebook(
         cells=[
             new_markdown_cell("# A fixture notebook\n\nWhat you will learn: nothing much."),
@@ -87,13 +89,14 @@ def surviving_solution_lines(source: nbformat.NotebookNode,
     """Lines unique to marked cells of ``source`` found in ``student``.
 
     The parts the student edition keeps on purpose are left out: a solution's task
-    comment and an answer's headings.
+    comment and function signatures (and docstrings), and an answer's headings.
     """
     marked, other = set(), set()
     for cell in source.cells:
         lines = cell.source.splitlines()
-        if se.SOLUTION_TAG in tags(cell):
-            lines = lines[len(se.task_instruction(cell.source)):]
+        if se.SOLUTION_TAG in tags(cell):  # the stub keeps the task and def signatures
+            kept = set(se.stub_source(cell.source).splitlines())
+            lines = [line for line in lines if line not in kept]
         elif se.ANSWER_TAG in tags(cell):
             lines = [line for line in lines if line not in se.answer_headings(cell.source)]
         (marked if is_marked(cell) else other).update(
@@ -159,6 +162,122 @@ def test_stub_is_task_then_raise():
                                  f'raise NotImplementedError("{se.STUB_MESSAGE}")']
     with pytest.raises(NotImplementedError, match="task described above"):
         exec(compile(stub, "<stub>", "exec"), {})
+
+
+RAISE = f'raise NotImplementedError("{se.STUB_MESSAGE}")'
+FUNCTION_TASK = '''# Task: write my_filter(y, A, C, Q, R, z0, P0) -> estimates (n, k): eq. (5).
+#       y has shape (k, m).
+@staticmethod
+def my_filter(y: "np.ndarray", A, C, Q, R,
+              z0=(0.0, 0.0), P0={"a": 1}, key=lambda v: v[0]) -> dict[str, int]:
+    """Tutorial eq. (5), one line per line.
+
+    Returns the estimates, shape (n, k).
+    """
+    # Gain first: the secret order.
+    def inner_secret(x):
+        return x
+    return inner_secret(y @ A)
+
+
+async def fetch(x): return x * 2  # one-liner
+
+
+def helper(a):
+    \'\'\'Doc.\'\'\'; return a
+
+
+estimates = my_filter(1, 2, 3, 4, 5)  # the worked call
+'''
+
+
+def test_stub_keeps_signatures_and_docstrings_and_raises_for_the_rest():
+    stub = se.stub_source(FUNCTION_TASK)
+    assert stub.splitlines() == [
+        *FUNCTION_TASK.splitlines()[:2],
+        "@staticmethod",
+        'def my_filter(y: "np.ndarray", A, C, Q, R,',
+        '              z0=(0.0, 0.0), P0={"a": 1}, key=lambda v: v[0]) -> dict[str, int]:',
+        '    """Tutorial eq. (5), one line per line.',
+        "",
+        "    Returns the estimates, shape (n, k).",
+        '    """',
+        f"    {RAISE}",
+        "", "",
+        "async def fetch(x):",
+        f"    {RAISE}",
+        "", "",
+        "def helper(a):",
+        "    \'\'\'Doc.\'\'\'",
+        f"    {RAISE}",
+        "", "",
+        RAISE,
+    ]
+    for secret in ("secret", "inner", "worked call", "return", "x * 2", "estimates ="):
+        assert secret not in stub.split("# Task:")[-1].split("\n", 2)[-1]
+
+
+def test_a_cell_of_functions_only_runs_and_its_functions_say_not_written():
+    source = "# Task: write twice(x) -> 2 x.\ndef twice(x):\n    # double it\n    return 2 * x\n"
+    stub = se.stub_source(source)
+    assert stub == f"# Task: write twice(x) -> 2 x.\ndef twice(x):\n    {RAISE}"
+    namespace: dict = {}
+    exec(compile(stub, "<stub>", "exec"), namespace)  # defining it raises nothing
+    with pytest.raises(NotImplementedError, match="task described above"):
+        namespace["twice"](1)
+
+
+@pytest.mark.parametrize("code", ["%timeit x = 1", "x = (", "if True:\n    def f():\n  pass"])
+def test_unparsable_or_magic_code_is_stubbed_whole(code):
+    assert se.stub_source(f"# Task: do it.\n{code}") == f"# Task: do it.\n{RAISE}"
+
+
+def test_allowed_tags_are_defined_once():
+    assert se.ALLOWED_TAGS == {"solution", "answer", "explorer", "nbval-ignore-output"}
+    assert {se.SOLUTION_TAG, se.ANSWER_TAG, se.EXPLORER_TAG,
+            se.IGNORE_OUTPUT_TAG} == se.ALLOWED_TAGS
+
+
+@pytest.mark.parametrize(
+    ("index", "cell", "message"),
+    [
+        (3, new_code_cell(SOLUTION, metadata={"tags": ["Solution"]}),
+         "unknown tag 'Solution' (did you mean 'solution'?)"),
+        (3, new_code_cell(SOLUTION, metadata={"tags": ["soluton"]}),
+         "unknown tag 'soluton' (did you mean 'solution'?)"),
+        (5, new_markdown_cell(ANSWER, metadata={"tags": ["answers"]}),
+         "unknown tag 'answers' (did you mean 'answer'?)"),
+        (5, new_markdown_cell(ANSWER, metadata={"tags": ["answer", "remove-me"]}),
+         "unknown tag 'remove-me'; the allowed tags are answer, explorer, "
+         "nbval-ignore-output, solution"),
+        (3, new_code_cell(SOLUTION), "starts like a task but is not tagged 'solution'"),
+        (3, new_code_cell("  #task : lower case and spaced\nx = 1"), "starts like a task"),
+        (6, new_code_cell(EXPLORER, metadata={"tags": ["explorer"]}),
+         "must also be tagged 'nbval-ignore-output'"),
+        (2, new_markdown_cell("text", metadata={"tags": ["explorer", "nbval-ignore-output"]}),
+         "is for code cells"),
+    ],
+)
+def test_unknown_tags_and_untagged_tasks_are_refused_with_the_cell_named(tmp_path, index, cell,
+                                                                         message):
+    notebook = fixture_notebook()
+    notebook.cells[index] = cell
+    first_line = cell.source.strip().splitlines()[0][:60]
+    with pytest.raises(ValueError) as error:
+        se.student_edition(notebook, "03_misspelt")
+    assert message in str(error.value)
+    assert str(error.value).startswith(f"03_misspelt, cell {index} ({first_line!r}): ")
+    source = write(notebook, tmp_path / "src" / "03_misspelt.ipynb")
+    assert se.main(["--source", str(source.parent), "--out", str(tmp_path / "out")]) == 1
+    assert not (tmp_path / "out").exists(), "a refused build writes nothing"
+
+
+def test_the_pack_metadata_is_kept():
+    notebook = fixture_notebook()
+    notebook.metadata["lqe"] = {"question": "a", "marks": 15, "core_minutes": 45}
+    student = nbformat.reads(se.student_edition(notebook, "f"), as_version=4)
+    assert student.metadata["lqe"] == {"question": "a", "marks": 15, "core_minutes": 45}
+    assert set(student.metadata) == {"kernelspec", "language_info", "lqe"}
 
 
 @pytest.mark.parametrize(
@@ -267,62 +386,6 @@ def test_a_notebook_without_solution_cells_is_refused(tmp_path):
     assert "times_secret" in written[1].read_text()
 
 
-def test_bad_folders_are_refused(tmp_path):
-    with pytest.raises(ValueError, match="source_dir must be an existing folder"):
-        se.build_student_edition(tmp_path / "missing", tmp_path / "out")
-    with pytest.raises(ValueError, match=r"at least one \.ipynb"):
-        se.build_student_edition(tmp_path, tmp_path / "out")
-    write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
-    with pytest.raises(ValueError, match="out_dir must differ from source_dir"):
-        se.build_student_edition(tmp_path / "src", tmp_path / "src" / ".." / "src")
-
-
-def test_stale_notebooks_are_removed_and_nothing_else(tmp_path):
-    write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
-    out = tmp_path / "out"
-    stale = out / "00_renamed.ipynb"
-    kept = [out / "notes.md", out / "00_renamed.html", out / "extra" / "old.ipynb"]
-    for path in [stale, *kept]:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text("from before")
-
-    # A refused build deletes nothing either.
-    write(fixture_notebook(with_solutions=False), tmp_path / "src" / "02_untagged.ipynb")
-    with pytest.raises(se.MissingSolutionsError):
-        se.build_student_edition(tmp_path / "src", out)
-    assert stale.read_text() == "from before"
-
-    (tmp_path / "src" / "02_untagged.ipynb").unlink()
-    written = se.build_student_edition(tmp_path / "src", out)
-    assert written == [out / "01_fixture.ipynb"]
-    assert not stale.exists()
-    assert all(path.read_text() == "from before" for path in kept)
-    assert sorted(path for path in out.rglob("*") if path.is_file()) == sorted([*written, *kept])
-
-
-def test_command_line(tmp_path, capsys):
-    source = write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
-    out = tmp_path / "out"
-    assert se.main(["--source", str(source.parent), "--out", str(out)]) == 0
-    assert capsys.readouterr().out.split() == [str(out / "01_fixture.ipynb")]
-
-    write(fixture_notebook(with_solutions=False), tmp_path / "src" / "02_untagged.ipynb")
-    assert se.main(["--source", str(source.parent), "--out", str(out)]) == 1
-    captured = capsys.readouterr()
-    assert captured.out == ""
-    assert "02_untagged.ipynb: no cell is tagged 'solution'" in captured.err
-    with pytest.warns(se.MissingSolutionsWarning):
-        assert se.main(["--source", str(source.parent), "--out", str(out),
-                        "--allow-without-solutions"]) == 0
-    assert len(capsys.readouterr().out.split()) == 2
-    # Bad input: exit code 1 and one "error:" line, as for the handouts.
-    assert se.main(["--source", str(tmp_path / "missing"), "--out", str(out)]) == 1
-    captured = capsys.readouterr()
-    assert captured.out == ""
-    assert captured.err == (f"error: source_dir must be an existing folder, got "
-                            f"{tmp_path / 'missing'}\n")
-
-
 # ------------------------------------------- every notebook, executed once a session
 
 
@@ -409,9 +472,14 @@ def assert_runs_until_first_stub(run: StudentRun) -> None:
     if not stubs:
         assert run.stopped_at is None, run.stop_error
         return
-    assert run.stopped_at == stubs[0], run.stop_error
-    assert run.stop_error.ename == "NotImplementedError"
-    assert se.STUB_MESSAGE in run.stop_error.evalue
+    if run.stopped_at == stubs[0] + 1 and se.CHECK_CALL in run.notebook.cells[
+            run.stopped_at].source:
+        # A stub of functions only runs; the check after it (a CheckFailed) says so.
+        assert "not written yet" in run.stop_error.evalue, run.stop_error.evalue
+    else:
+        assert run.stopped_at == stubs[0], run.stop_error
+        assert run.stop_error.ename == "NotImplementedError"
+        assert se.STUB_MESSAGE in run.stop_error.evalue
     for cell in run.notebook.cells[: stubs[0]]:
         for output in cell.get("outputs", []):
             assert output.output_type != "error"
@@ -513,3 +581,288 @@ def test_student_notebook_runs_until_its_first_stub(student_runs, key, name):
 @pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
 def test_explorers_run_on_their_own_in_the_student_edition(student_runs, key, name):
     assert_explorers_work(student_runs(key, name))
+
+
+# ---------------------- a student who writes the worked solutions passes every check
+
+QUESTION_NOTEBOOKS = [name for name in REAL if name[:3] in {"01_", "02_", "03_", "04_", "05_"}]
+
+
+def core_end(notebook: nbformat.NotebookNode) -> int:
+    """Index of the ``## Going further`` heading cell (the end of the core path)."""
+    return next((index for index, cell in enumerate(notebook.cells)
+                 if cell.cell_type == "markdown"
+                 and cell.source.lstrip().startswith(se.GOING_FURTHER)), len(notebook.cells))
+
+
+def filled_core(source: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
+    """The student edition's core path with every task filled with the worked solution.
+
+    Task i of the edition gets the code of solution cell i of the source (the edition
+    keeps the cells in order); everything after ``## Going further`` is left out.
+    """
+    student = nbformat.reads(se.student_edition(source, name), as_version=4)
+    solutions = [cell for cell in source.cells if se.SOLUTION_TAG in tags(cell)]
+    stubs = [cell for cell in student.cells if se.TASK_TAG in tags(cell)]
+    assert len(stubs) == len(solutions)
+    for stub, solution in zip(stubs, solutions, strict=True):
+        assert stub.source.splitlines()[0] == solution.source.splitlines()[0]
+        stub.source = solution.source
+    student.cells = student.cells[:core_end(student)]
+    return student
+
+
+def check_cells(notebook: nbformat.NotebookNode) -> list[int]:
+    """Indices of the check cells: the untagged code cell right after each task."""
+    return [index + 1 for index, cell in enumerate(notebook.cells[:-1])
+            if se.TASK_TAG in tags(cell) and se.CHECK_CALL in notebook.cells[index + 1].source
+            and not tags(notebook.cells[index + 1])]
+
+
+def run_filled(notebook: nbformat.NotebookNode, cwd: Path) -> CellExecutionError | None:
+    """Execute ``notebook`` in a fresh kernel; the error that stopped it, if any."""
+    client = NotebookClient(notebook, timeout=300, kernel_name="python3",
+                            resources={"metadata": {"path": str(cwd)}})
+    try:
+        client.execute()
+    except CellExecutionError as error:
+        return error
+    return None
+
+
+def assert_every_check_passed(notebook: nbformat.NotebookNode,
+                              error: CellExecutionError | None) -> None:
+    assert error is None, f"the filled student edition stopped: {error}"
+    for index in check_cells(notebook):
+        cell = notebook.cells[index]
+        kinds = [output.output_type for output in cell.outputs]
+        printed = "".join(output.get("text", "") for output in cell.outputs)
+        assert "error" not in kinds, f"check cell {index}: {cell.source}"
+        assert printed.startswith("✓ "), f"check cell {index} ({cell.source}) printed {printed!r}"
+
+
+def test_the_filled_edition_run_can_fail(tmp_path):
+    """A wrong solution in a task makes its check fail; a right one passes."""
+    from lqe_helpers import checks
+
+    assert issubclass(checks.CheckFailed, AssertionError)
+    right = "# Task: build P0 = 1e5 I₃ (cm²).\nimport numpy as np\nP0 = 1e5 * np.eye(3)"
+    notebook = new_notebook(
+        cells=[new_markdown_cell("# Fixture"),
+               new_code_cell("from lqe_helpers import checks"),
+               new_code_cell(right, metadata={"tags": ["solution"]}),
+               new_code_cell("checks.check_initial_covariance(P0, 1e5)"),
+               new_markdown_cell("## Going further\n\nOptional."),
+               new_code_cell("raise RuntimeError('not reached: Going further is left out')")],
+        metadata={"kernelspec": KERNELSPEC, "language_info": {"name": "python"}})
+    filled = filled_core(notebook, "fixture")
+    assert check_cells(filled) == [4]  # the note comes in at 1
+    assert_every_check_passed(filled, run_filled(filled, tmp_path))
+    notebook.cells[2].source = right.replace("1e5 * np.eye(3)", "np.sqrt(1e5) * np.eye(3)")
+    filled = filled_core(notebook, "fixture")
+    error = run_filled(filled, tmp_path)
+    assert error is not None and error.ename == "CheckFailed"
+    with pytest.raises(AssertionError):
+        assert_every_check_passed(filled, error)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", QUESTION_NOTEBOOKS)
+def test_worked_solutions_pass_every_check_in_the_student_edition(name):
+    """Core path only (up to ``## Going further``): that is where every task has a check."""
+    source = nbformat.read(NOTEBOOKS / name, as_version=4)
+    filled = filled_core(source, Path(name).stem)
+    assert check_cells(filled), f"{name}: no task of the core path is followed by a check"
+    assert_every_check_passed(filled, run_filled(filled, NOTEBOOKS))
+
+
+# ==================================================================================
+# File safety of the student edition (owner: the file-safety work of issue 10). The
+# tests above are about the transformation; these about what the build reads and writes.
+# ==================================================================================
+
+
+def _snapshot(folder: Path) -> dict[str, bytes | str]:
+    """Every file (its bytes), link (its target) and folder under ``folder``."""
+    return {path.relative_to(folder).as_posix():
+            (f"link -> {path.readlink()}" if path.is_symlink()
+             else "folder" if path.is_dir() else path.read_bytes())
+            for path in sorted(folder.rglob("*"))}
+
+
+def _course(tmp_path: Path) -> Path:
+    """A course folder C with seven worked notebooks and a drafts/ subfolder of two."""
+    course = tmp_path / "C"
+    for number in range(7):
+        write(fixture_notebook(), course / f"0{number}_worked.ipynb")
+    for number in range(2):
+        write(fixture_notebook(), course / "drafts" / f"0{number}_draft.ipynb")
+    return course
+
+
+def test_file_safety_bad_folders_are_refused(tmp_path):
+    with pytest.raises(ValueError, match="source_dir must be an existing folder"):
+        se.build_student_edition(tmp_path / "missing", tmp_path / "out")
+    with pytest.raises(ValueError, match=r"at least one \.ipynb"):
+        se.build_student_edition(tmp_path, tmp_path / "out")
+    write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
+    (tmp_path / "file").write_text("a file")
+    before = _snapshot(tmp_path)
+    for out, message in [(tmp_path / "src" / ".." / "src", "is the source folder"),
+                         (tmp_path / "src" / "student", "lies inside the source folder"),
+                         (tmp_path, "contains the source folder"),
+                         (tmp_path / "file", "is a file; give a folder")]:
+        with pytest.raises(se.OutputFolderError, match=message):
+            se.build_student_edition(tmp_path / "src", out)
+    assert _snapshot(tmp_path) == before
+
+
+def test_file_safety_drafts_written_into_the_course_folder_delete_nothing(tmp_path, capsys):
+    """The issue's case: --source C/drafts --out C exited 0 and deleted seven notebooks."""
+    course = _course(tmp_path)
+    before = _snapshot(course)
+    assert se.main(["--source", str(course / "drafts"), "--out", str(course)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (f"error: the output folder {course} contains the source folder "
+                            f"{course / 'drafts'}, so a build could replace or delete source "
+                            f"files; write it somewhere else\n")
+    assert _snapshot(course) == before
+
+
+def test_file_safety_grading_notes_and_foreign_notebooks_are_never_touched(tmp_path):
+    """The issue's case: my_grading_notes.ipynb in --out was deleted."""
+    write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
+    out = tmp_path / "out"
+    out.mkdir()
+    mine = {"my_grading_notes.ipynb": "grading notes", "00_renamed.ipynb": "not the tool's",
+            "notes.md": "notes", "extra/old.ipynb": "old"}
+    for name, text in mine.items():
+        (out / name).parent.mkdir(parents=True, exist_ok=True)
+        (out / name).write_text(text)
+    written = se.build_student_edition(tmp_path / "src", out)
+    assert written == [out / "01_fixture.ipynb"]
+    assert {name: (out / name).read_text() for name in mine} == mine
+    assert sorted(path.relative_to(out).as_posix() for path in out.rglob("*") if path.is_file()
+                  ) == sorted([*mine, "01_fixture.ipynb", se.MANIFEST_NAME])
+    # A notebook of the instructor's in the way of the build stops it; nothing changes.
+    (out / "01_fixture.ipynb").unlink()
+    (tmp_path / "src" / "my_grading_notes.ipynb").write_bytes(
+        (tmp_path / "src" / "01_fixture.ipynb").read_bytes())
+    before = _snapshot(out)
+    with pytest.raises(se.OutputFolderError,
+                       match=r"my_grading_notes\.ipynb was not written by student_edition"):
+        se.build_student_edition(tmp_path / "src", out)
+    assert _snapshot(out) == before
+
+
+def test_file_safety_a_renamed_notebooks_old_edition_goes_a_hand_edited_one_stays(tmp_path):
+    write(fixture_notebook(), tmp_path / "src" / "00_old_name.ipynb")
+    write(fixture_notebook(), tmp_path / "src" / "02_other.ipynb")
+    out = tmp_path / "out"
+    se.build_student_edition(tmp_path / "src", out)
+    (out / "02_other.ipynb").write_text("edited by the instructor after the build")
+    (tmp_path / "src" / "00_old_name.ipynb").rename(tmp_path / "src" / "01_new_name.ipynb")
+    (tmp_path / "src" / "02_other.ipynb").rename(tmp_path / "src" / "03_other.ipynb")
+    se.build_student_edition(tmp_path / "src", out)
+    assert sorted(path.name for path in out.iterdir()) == [
+        se.MANIFEST_NAME, "01_new_name.ipynb", "02_other.ipynb", "03_other.ipynb"]
+    assert (out / "02_other.ipynb").read_text() == "edited by the instructor after the build"
+
+
+def test_file_safety_a_symlink_in_out_is_not_written_through(tmp_path):
+    """The issue's case: a link in --out to a worked notebook got its student edition."""
+    course = _course(tmp_path)
+    worked = course / "01_worked.ipynb"
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "01_worked.ipynb").symlink_to(worked)
+    before, course_before = _snapshot(out), _snapshot(course)
+    with pytest.raises(se.OutputFolderError, match=r"01_worked\.ipynb is a symbolic link"):
+        se.build_student_edition(course, out)
+    assert _snapshot(out) == before
+    assert _snapshot(course) == course_before
+
+
+def test_file_safety_a_failure_while_writing_changes_nothing(tmp_path, monkeypatch):
+    from lqe_helpers.authoring import files
+
+    write(fixture_notebook(), tmp_path / "src" / "01_a.ipynb")
+    write(fixture_notebook(), tmp_path / "src" / "02_b.ipynb")
+    out = tmp_path / "out"
+    se.build_student_edition(tmp_path / "src", out)
+    (tmp_path / "src" / "01_a.ipynb").write_text(
+        (tmp_path / "src" / "01_a.ipynb").read_text().replace("marmalade", "jam"))
+    before = _snapshot(tmp_path)
+    real, calls = files._write_fd, []
+
+    def full_disk(fd: int, data: bytes) -> None:
+        calls.append(len(data))
+        if len(calls) == 2:
+            real(fd, data[:100])
+            raise OSError(28, "No space left on device")
+        real(fd, data)
+
+    monkeypatch.setattr(files, "_write_fd", full_disk)
+    with pytest.raises(se.OutputWriteError, match="No space left on device"):
+        se.build_student_edition(tmp_path / "src", out)
+    assert _snapshot(tmp_path) == before
+
+
+@pytest.mark.parametrize(("content", "message"), [
+    ("{broken", "01_bad.ipynb is not a notebook (not valid JSON: "),
+    ('{"nbformat": 4, "cells": 3}', "01_bad.ipynb is not a valid notebook: "),
+])
+def test_file_safety_a_file_that_is_not_a_notebook_is_one_error_line(tmp_path, capsys,
+                                                                     content, message):
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "01_bad.ipynb").write_text(content)
+    assert se.main(["--source", str(tmp_path / "src"), "--out", str(tmp_path / "out")]) == 1
+    captured = capsys.readouterr()
+    [line] = captured.err.splitlines()
+    assert line.startswith("error: ")
+    assert message in line, line
+    assert not (tmp_path / "out").exists()
+
+
+def test_file_safety_an_unknown_tag_is_one_error_line(tmp_path, capsys):
+    notebook = fixture_notebook()
+    notebook.cells[2].metadata["tags"] = ["Solution"]
+    write(notebook, tmp_path / "src" / "01_fixture.ipynb")
+    assert se.main(["--source", str(tmp_path / "src"), "--out", str(tmp_path / "out")]) == 1
+    captured = capsys.readouterr()
+    [line] = captured.err.splitlines()
+    assert line.startswith("error: 01_fixture, cell 2 ")
+    assert "'Solution'" in line
+    assert not (tmp_path / "out").exists()
+
+
+def test_file_safety_command_line(tmp_path, capsys):
+    source = write(fixture_notebook(), tmp_path / "src" / "01_fixture.ipynb")
+    out = tmp_path / "out"
+    assert se.main(["--source", str(source.parent), "--out", str(out)]) == 0
+    assert capsys.readouterr().out.split() == [str(out / "01_fixture.ipynb")]
+
+    write(fixture_notebook(with_solutions=False), tmp_path / "src" / "02_untagged.ipynb")
+    before = _snapshot(out)
+    assert se.main(["--source", str(source.parent), "--out", str(out)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    [line] = captured.err.splitlines()
+    assert line.startswith("error: 02_untagged.ipynb: no cell is tagged 'solution'")
+    assert "--allow-without-solutions" in line
+    assert _snapshot(out) == before
+    # Allowed: one warning line that names the flag that allowed it.
+    assert se.main(["--source", str(source.parent), "--out", str(out),
+                    "--allow-without-solutions"]) == 0
+    captured = capsys.readouterr()
+    assert len(captured.out.split()) == 2
+    assert captured.err == ("warning: 02_untagged.ipynb: no cell is tagged 'solution'; built "
+                            "anyway because of --allow-without-solutions, so its student "
+                            "edition contains every worked answer\n")
+    # Bad input: exit code 1 and one "error:" line, as for the handouts.
+    assert se.main(["--source", str(tmp_path / "missing"), "--out", str(out)]) == 1
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err == (f"error: source_dir must be an existing folder, got "
+                            f"{tmp_path / 'missing'}\n")

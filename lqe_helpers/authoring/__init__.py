@@ -1,4 +1,6 @@
-"""Course tools for instructors and authors: run notebooks, build handouts, build the student edition.
+"""Course tools for instructors and authors.
 
-Not imported by the science modules or the explorers; run as ``python -m lqe_helpers.authoring.…``.
+Run notebooks, build handouts, build the student edition, its pack and the marking guide.
+Not imported by the science modules or the explorers; run as
+``python -m lqe_helpers.authoring.<tool>``.
 """

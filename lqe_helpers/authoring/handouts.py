@@ -12,19 +12,22 @@ Each notebook is executed once, in a fresh kernel, by
 :func:`lqe_helpers.authoring.notebook_runner.execute_notebook`. A notebook that raises, shows an
 error output, or displays a widget with no static view (which a page could only show
 as a placeholder) stops the build, and the message names the notebook and the cell
-(and gives the traceback); output on stderr (a warning) is reported but kept. Only
-once every notebook has run is anything written: then every other ``*.html`` file
-directly in the output folder or its ``prose/`` folder (the page of a notebook since
-renamed or removed) is deleted, so the folders hold exactly the current pages.
+(and gives the traceback); output on stderr (a warning) is reported but kept. A cell
+may run ``--timeout`` seconds (default 300). Only once every page is ready is anything
+written, all together or not at all (:mod:`lqe_helpers.authoring.files`): the folder's
+manifest ``.lqe-manifest.json`` lists what the build wrote, so the next build replaces or
+deletes only those files (the page of a notebook since renamed goes) and only while they
+are unchanged. Any other file there (an instructor's ``course_home.html``) is never
+touched; one in the way of a page stops the build before anything is written.
 Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
 
 - every figure embedded as a base64 ``data:`` URI (outputs and markdown images);
 - the widget-view mimetype left out of the display priority, so an explorer shows
   its static figure at the default values with a note that the sliders live in
   JupyterLab, never a widget placeholder;
-- no require.js, widget-manager or mermaid scripts. MathJax is the one remote script
-  and loads ``async``: offline, the equations stay readable as their LaTeX source
-  and nothing waits for the network;
+- no require.js, widget-manager or mermaid scripts; MathJax is copied into the folder
+  (``mathjax/``) and typesets every equation with no network, and every figure and
+  page carries the accessibility of :mod:`lqe_helpers.authoring.handout_pages`;
 - nbconvert's ``TagRemovePreprocessor`` honouring the usual ``remove-cell``,
   ``remove-input`` and ``remove-output`` tags, should an author want a cell hidden;
 - markdown links to another notebook of the pack (``03_fusion.ipynb#...``) pointed
@@ -36,114 +39,51 @@ from __future__ import annotations
 import argparse
 import copy
 import re
-import sys
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from urllib.parse import quote
 
 import nbformat
-from jinja2 import DictLoader
-from nbclient.exceptions import CellTimeoutError, DeadKernelError
 from nbconvert.exporters import HTMLExporter
 from nbconvert.filters import strip_ansi
 from nbconvert.preprocessors import Preprocessor
 from traitlets import List, Unicode
-from traitlets.config import Config
 
-from lqe_helpers.authoring.notebook_runner import WIDGET_VIEW_MIMETYPE, execute_notebook, fail
-from lqe_helpers.authoring.student_edition import check_out_dir, remove_stale, source_notebooks
+from lqe_helpers.authoring import handout_pages
+from lqe_helpers.authoring.files import (
+    CommandLineParser,
+    ToolError,
+    plan_output_folder,
+    run_command,
+    source_notebooks,
+    write_output_folder,
+)
+from lqe_helpers.authoring.notebook_runner import (
+    CELL_TIMEOUT,
+    WIDGET_VIEW_MIMETYPE,
+    NotebookRunError,
+    execute_notebook,
+    positive_seconds,
+)
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"
 #: Title of the index pages.
 PACK_TITLE = "The Linear Quadratic Estimator: tracking a butterfly"
-#: Where MathJax comes from; an empty string leaves it out (equations stay as LaTeX).
-DEFAULT_MATHJAX_URL = (
-    "https://cdnjs.cloudflare.com/ajax/libs/mathjax/2.7.7/MathJax.js?config=TeX-AMS_CHTML-full,Safe"
-)
-#: What an HTML page may show from a display bundle, best first. The widget view is
-#: not in the list: with no widget manager it could only render as a placeholder.
-DISPLAY_PRIORITY = [
-    "text/html",
-    "text/markdown",
-    "image/svg+xml",
-    "text/latex",
-    "image/png",
-    "image/jpeg",
-    "text/plain",
-]
+#: ``mathjax_url`` that copies MathJax into the output folder and loads it from there.
+LOCAL_MATHJAX = "local"
+#: Where the pages load MathJax from by default: the copy in the output folder.
+DEFAULT_MATHJAX_URL = LOCAL_MATHJAX
+#: What an HTML page may show from a display bundle, best first (no widget view).
+DISPLAY_PRIORITY = handout_pages.DISPLAY_PRIORITY
 
-_TEMPLATE_NAME = "lqe_handout.html.j2"
-_TEMPLATE = r"""
-{%- extends 'index.html.j2' -%}
-
-{%- macro lqe_nav(nav) -%}
-{%- if nav -%}
-<nav class="lqe-nav" aria-label="Handout pages">
-  <span>{%- if nav.previous -%}
-    <a rel="prev" href="{{ nav.previous.href }}">&larr; {{ nav.previous.title | e }}</a>
-  {%- endif -%}</span>
-  <a href="{{ nav.index }}">All handouts</a>
-  <span>{%- if nav.next -%}
-    <a rel="next" href="{{ nav.next.href }}">{{ nav.next.title | e }} &rarr;</a>
-  {%- endif -%}</span>
-</nav>
-{%- endif -%}
-{%- endmacro -%}
-
-{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
-{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
-{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
-
-{%- block html_head_js_mathjax -%}
-{%- if resources.mathjax_url -%}
-<script type="text/x-mathjax-config">
-MathJax.Hub.Config({
-  TeX: {equationNumbers: {autoNumber: "AMS", useLabelIds: true}},
-  tex2jax: {
-    inlineMath: [["$", "$"], ["\\(", "\\)"]],
-    displayMath: [["$$", "$$"], ["\\[", "\\]"]],
-    processEscapes: true,
-    processEnvironments: true
-  },
-  displayAlign: "center",
-  messageStyle: "none",
-  CommonHTML: {linebreaks: {automatic: true}}
-});
-</script>
-<script async src="{{ resources.mathjax_url }}"></script>
-{%- endif -%}
-{%- endblock html_head_js_mathjax -%}
-
-{%- block extra_css -%}
-<style type="text/css">
-nav.lqe-nav {
-  display: flex; justify-content: space-between; gap: 1em;
-  max-width: 1100px; margin: 0.5em auto; padding: 0.4em 1em;
-  font-family: var(--jp-ui-font-family); font-size: 0.95em;
-  border-bottom: 1px solid var(--jp-border-color2);
-}
-nav.lqe-nav + main, main + nav.lqe-nav { border-top: 1px solid var(--jp-border-color2); }
-figure.lqe-explorer { margin: 0; }
-figure.lqe-explorer img { max-width: 100%; height: auto; }
-figure.lqe-explorer figcaption { color: var(--jp-content-font-color2); margin-top: 0.3em; }
-</style>
-{%- endblock extra_css -%}
-
-{%- block body_header -%}
-{{ super() }}
-{{ lqe_nav(resources.lqe_nav) }}
-{%- endblock body_header -%}
-
-{%- block body_footer -%}
-{{ lqe_nav(resources.lqe_nav) }}
-{{ super() }}
-{%- endblock body_footer -%}
-"""
+#: Name the handouts build records in its output folder's manifest.
+TOOL_NAME = "handouts"
 
 
-class HandoutBuildError(RuntimeError):
+class HandoutBuildError(ToolError, RuntimeError):
     """A notebook could not be turned into a handout (it raised, or shows an error)."""
 
 
@@ -188,9 +128,14 @@ class Page:
     title: str
 
     @property
-    def href(self) -> str:
-        """The page's file name, relative to its index."""
+    def file_name(self) -> str:
+        """The page's file name (``<stem>.html``, spaces and accents as they are)."""
         return f"{self.stem}.html"
+
+    @property
+    def href(self) -> str:
+        """The page's link relative to its index: the file name, URL-quoted (UTF-8)."""
+        return quote(self.file_name)
 
 
 def notebook_title(notebook: nbformat.NotebookNode, fallback: str) -> str:
@@ -257,9 +202,9 @@ def stderr_outputs(notebook: nbformat.NotebookNode) -> list[str]:
     ]
 
 
-def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_URL,
+def handout_exporter(*, code: bool = True, mathjax_url: str = "",
                      stems: Sequence[str] = ()) -> HTMLExporter:
-    """The HTML exporter for handout pages.
+    """The HTML exporter for handout pages (:func:`handout_pages.handout_exporter`).
 
     Parameters
     ----------
@@ -267,28 +212,15 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = DEFAULT_MATHJAX_UR
         Show the code cells' source (``False`` for the prose variant: markdown,
         printed results and figures only, without prompts).
     mathjax_url : str
-        Where MathJax is loaded from (``async``); ``""`` leaves MathJax out.
+        URL that loads MathJax as the page sees it
+        (:func:`handout_pages.mathjax_url` for the local copy); ``""`` leaves it out.
     stems : sequence of str
         File stems of the notebooks that get a page next to this one; markdown links
         to ``<stem>.ipynb`` are pointed at ``<stem>.html``.
     """
-    config = Config()
-    config.NbConvertBase.display_data_priority = list(DISPLAY_PRIORITY)
-    config.HTMLExporter.embed_images = True
-    config.HTMLExporter.mathjax_url = mathjax_url
-    config.TagRemovePreprocessor.enabled = True
-    config.TagRemovePreprocessor.remove_cell_tags = {"remove-cell"}
-    config.TagRemovePreprocessor.remove_input_tags = {"remove-input"}
-    config.TagRemovePreprocessor.remove_all_outputs_tags = {"remove-output"}
-    if not code:
-        config.TemplateExporter.exclude_input = True
-        config.TemplateExporter.exclude_input_prompt = True
-        config.TemplateExporter.exclude_output_prompt = True
-    exporter = HTMLExporter(config=config, template_name="lab",
-                            extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
-    exporter.template_file = _TEMPLATE_NAME
-    exporter.register_preprocessor(NotebookLinkPreprocessor(stems=list(stems)), enabled=True)
-    return exporter
+    return handout_pages.handout_exporter(
+        code=code, mathjax_url=mathjax_url,
+        preprocessors=[NotebookLinkPreprocessor(stems=list(stems))])
 
 
 def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNode:
@@ -296,13 +228,13 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
     if code:
         intro = ("Each page is a notebook of the pack, executed afresh: the text, the code and "
                  "every figure. The interactive explorers appear as a figure at their default "
-                 "values; open the notebooks in JupyterLab to move their sliders. The same pages "
-                 f"without code are in [{PROSE_DIR}/]({PROSE_DIR}/index.html).")
+                 "values; open the notebooks in JupyterLab to move their sliders. Also here: "
+                 f"[the same pages without code]({PROSE_DIR}/index.html).")
     else:
         intro = ("Each page is a notebook of the pack, executed afresh, showing its text, "
                  "printed results and figures without the code. The interactive explorers "
                  "appear as a figure at their default values; open the notebooks in JupyterLab "
-                 "to move their sliders. The pages with code are [here](../index.html).")
+                 "to move their sliders. Also here: [the same pages with code](../index.html).")
     items = []
     for number, page in enumerate(pages, start=1):
         title = page.title.replace("[", r"\[").replace("]", r"\]")
@@ -314,18 +246,19 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
     return notebook
 
 
-def _execute(path: Path) -> nbformat.NotebookNode:
+def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode:
     """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
 
     Every cell runs even after one raises, so the message can name each cell that
     shows an error (the first is usually the cause; later ones may follow from it)
-    and give the first traceback. Warns (:class:`HandoutWarning`) if a cell printed
-    to stderr.
+    and give the first traceback. A cell past ``timeout`` seconds or a kernel that
+    dies stops the build too. Warns (:class:`HandoutWarning`) if a cell printed to
+    stderr.
     """
     try:
-        notebook = execute_notebook(path, allow_errors=True)
-    except (CellTimeoutError, DeadKernelError) as error:
-        raise HandoutBuildError(f"{path}: {error}") from error
+        notebook = execute_notebook(path, timeout, allow_errors=True)
+    except NotebookRunError as error:
+        raise HandoutBuildError(str(error)) from error
     errors = error_outputs(notebook)
     if errors:
         raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}\n"
@@ -335,6 +268,12 @@ def _execute(path: Path) -> nbformat.NotebookNode:
         raise HandoutBuildError(
             f"{path} displays widget(s) with no static view, which a page could only show "
             f"as a placeholder (display an Explorer, or a figure): {'; '.join(widgets)}")
+    undescribed = handout_pages.undescribed_figures(notebook)
+    if undescribed:
+        warnings.warn(f"{path} shows figure(s) with no description, which its page can "
+                      f"only give a generic alt text (show them with plotting.show_figure): "
+                      f"{'; '.join(undescribed)}",
+                      HandoutWarning, stacklevel=3)
     printed = stderr_outputs(notebook)
     if printed:
         warnings.warn(f"{path} prints to stderr, which its page will show: "
@@ -343,22 +282,40 @@ def _execute(path: Path) -> nbformat.NotebookNode:
     return notebook
 
 
+def _page_names(stems: Sequence[str]) -> list[str]:
+    """The files a build writes for notebooks ``stems``, relative to the output folder."""
+    return [f"{folder}{name}" for folder in ("", f"{PROSE_DIR}/")
+            for name in [*(f"{stem}.html" for stem in stems), "index.html"]]
+
+
 def build_handouts(source_dir: Path, out_dir: Path, *,
-                   mathjax_url: str = DEFAULT_MATHJAX_URL) -> list[Path]:
+                   mathjax_url: str = DEFAULT_MATHJAX_URL,
+                   timeout: float = CELL_TIMEOUT) -> list[Path]:
     """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
+
+    The output folder is checked before any notebook runs, and written only once every
+    page is ready, all together (:func:`~lqe_helpers.authoring.files.write_output_folder`):
+    any failure leaves it as it was. The build records what it wrote in the folder's
+    manifest (``.lqe-manifest.json``); a rebuild replaces or deletes only those files,
+    and only while they are unchanged. Every other file in the folder (an instructor's
+    ``course_home.html``) is left alone, and one in the way of a page stops the build.
 
     Parameters
     ----------
     source_dir : Path
         Folder of the source notebooks (``*.ipynb``, in name order; read only).
     out_dir : Path
-        Output folder (created if needed). Receives ``NN_name.html`` per notebook and
-        ``index.html``; ``out_dir/prose/`` receives the same without code cells. Once
-        every notebook has run, any other ``*.html`` file directly in either folder
-        (left by an earlier build) is deleted; nothing else there is touched. A
-        notebook that stops the build stops it before anything is written or deleted.
+        Output folder (created if needed); must not be, contain or lie inside
+        ``source_dir``. Receives ``NN_name.html`` per notebook and ``index.html``;
+        ``out_dir/prose/`` receives the same without code cells. Pages of an earlier
+        build that this one does not write (a renamed notebook) are deleted.
     mathjax_url : str
-        Where the pages load MathJax from (asynchronously); ``""`` leaves it out.
+        :data:`LOCAL_MATHJAX` (default): MathJax is copied into ``out_dir/mathjax/``
+        (:func:`handout_pages.mathjax_copy`, listed in the manifest, not in the returned
+        list) and every page loads it from there, so the folder works offline anywhere.
+        Any other URL is loaded as it is (asynchronously); ``""`` leaves MathJax out.
+    timeout : float
+        Seconds one cell may run.
 
     Returns
     -------
@@ -369,23 +326,31 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     Raises
     ------
     ValueError
-        If ``source_dir`` holds no notebook or ``out_dir`` is ``source_dir``.
+        If ``source_dir`` holds no notebook or a source notebook is not a valid one.
+    OutputFolderError
+        If ``out_dir`` is a file, overlaps ``source_dir``, or holds a file in the way
+        of a page that this tool did not write (or that was changed since).
+    OutputWriteError
+        If writing fails (disk full, read-only folder); ``out_dir`` is as it was.
     HandoutBuildError
-        If a notebook raises, shows an error output or displays a widget with
-        no static view.
+        If a notebook raises, shows an error output, displays a widget with no static
+        view, runs a cell past ``timeout`` or kills its kernel.
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
     paths = source_notebooks(source_dir)
-    check_out_dir(source_dir, out_dir)
-    executed = [(path, _execute(path)) for path in paths]
+    local = mathjax_url == LOCAL_MATHJAX
+    mathjax = handout_pages.mathjax_copy() if local else {}
+    plan_output_folder(out_dir, [*_page_names([path.stem for path in paths]), *mathjax],
+                       tool=TOOL_NAME, source_dir=source_dir)
+    executed = [(path, _execute(path, timeout)) for path in paths]
     pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
 
-    written = []
-    names = {page.href for page in pages} | {"index.html"}
-    for code, folder in ((True, out_dir), (False, out_dir / PROSE_DIR)):
-        folder.mkdir(parents=True, exist_ok=True)
-        remove_stale(folder, "*.html", keep=names)
-        exporter = handout_exporter(code=code, mathjax_url=mathjax_url,
+    # Every file of the build, relative to out_dir; anything else the handouts need
+    # (a copy of MathJax, say) goes in here too, so the manifest covers it.
+    files: dict[str, str | bytes] = {}
+    for code, folder in ((True, ""), (False, f"{PROSE_DIR}/")):
+        page_mathjax = handout_pages.mathjax_url(folder.count("/")) if local else mathjax_url
+        exporter = handout_exporter(code=code, mathjax_url=page_mathjax,
                                     stems=[page.stem for page in pages])
         for number, ((path, notebook), page) in enumerate(zip(executed, pages, strict=True)):
             nav = {
@@ -398,36 +363,41 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
             resources = {"metadata": {"name": page.stem, "path": str(path.parent.resolve())},
                          "lqe_nav": nav}
             html, _ = exporter.from_notebook_node(notebook, resources)
-            target = folder / page.href
-            target.write_text(html, encoding="utf-8")
-            written.append(target)
+            files[folder + page.file_name] = html
         html, _ = exporter.from_notebook_node(
             _index_notebook(pages, code=code), {"metadata": {"name": "index"}})
-        target = folder / "index.html"
-        target.write_text(html, encoding="utf-8")
-        written.append(target)
-    return written
+        files[folder + "index.html"] = html
+    pages_written = len(files)
+    files.update(mathjax)
+    return write_output_folder(out_dir, files, tool=TOOL_NAME,
+                               source_dir=source_dir)[:pages_written]
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line: build the handouts and list the files written."""
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser = CommandLineParser(prog="python -m lqe_helpers.authoring.handouts",
+                               description=__doc__.splitlines()[0])
     parser.add_argument("--source", type=Path, default=Path("notebooks"),
                         help="folder of the source notebooks (default: notebooks)")
     parser.add_argument("--out", type=Path, default=Path("build/handouts"),
-                        help="output folder (default: build/handouts); any other .html file "
-                             f"directly in it or in its {PROSE_DIR}/ folder is deleted")
+                        help="output folder (default: build/handouts); a rebuild replaces only "
+                             "the files listed in its .lqe-manifest.json")
     parser.add_argument("--mathjax-url", default=DEFAULT_MATHJAX_URL,
-                        help="where pages load MathJax from; '' for none (LaTeX shown as text)")
-    args = parser.parse_args(argv)
-    try:
-        written = build_handouts(args.source, args.out, mathjax_url=args.mathjax_url)
-    except (ValueError, HandoutBuildError) as error:
-        return fail(error)
-    for path in written:
-        print(path)
-    return 0
+                        help=f"where pages load MathJax from: '{LOCAL_MATHJAX}' (default) copies "
+                             "it into the output folder; '' for none (LaTeX shown as text)")
+    parser.add_argument("--timeout", type=positive_seconds, default=CELL_TIMEOUT,
+                        metavar="SECONDS",
+                        help=f"seconds one cell may run before the build stops "
+                             f"(default: {CELL_TIMEOUT})")
+
+    def command(args: argparse.Namespace) -> int:
+        for path in build_handouts(args.source, args.out, mathjax_url=args.mathjax_url,
+                                   timeout=args.timeout):
+            print(path)
+        return 0
+
+    return run_command(parser, command, argv)
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    raise SystemExit(main())

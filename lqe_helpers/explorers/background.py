@@ -163,6 +163,15 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
                        f"filter expects {expected:.3g} cm²", fontsize=10)
 
 
+def describe_background(*, jerk_std: float, scenario: Scenario = DEFAULT) -> str:
+    """What :func:`draw_background` shows at ``jerk_std`` (its alt text)."""
+    return (f"Left: twice the standard deviation of the predicted position over "
+            f"{OPEN_LOOP_DURATION:g} s without measurements, at σ_j = {format_jerk(jerk_std)} "
+            f"cm/s³ and at the scenario's σ_j, against the flight's amplitude. Right: vision, "
+            f"the true path and the filtered estimate from {TRACKING_WINDOW[0]:g} to "
+            f"{TRACKING_WINDOW[1]:g} s.")
+
+
 def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
     """Slider for σ_j (log scale): open-loop growth and tracking respond together.
 
@@ -184,4 +193,5 @@ def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
         {"jerk_std": slider},
         partial(draw_background, scenario=scenario, noise=noise),
         figsize=(10.0, 4.2),
+        describe=partial(describe_background, scenario=scenario),
     )

@@ -24,7 +24,14 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model
-from ..explorer import Explorer, float_slider, log_slider, reuse_panels, starting_value
+from ..explorer import (
+    DATA_UNDER_LINES,
+    Explorer,
+    float_slider,
+    log_slider,
+    reuse_panels,
+    starting_value,
+)
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -74,7 +81,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     times = scenario.times[_shown(scenario)]
     empty = np.zeros_like(times)
     band = bias_ax.fill_between(times, empty, empty, color=COLORS["estimate"], alpha=0.15,
-                                linewidth=0, label=BIAS_BAND_LABEL)
+                                linewidth=0, label=BIAS_BAND_LABEL, zorder=DATA_UNDER_LINES)
     true_bias, = bias_ax.plot(times, empty, **style("truth", label=TRUE_BIAS_LABEL))
     bias_estimate, = bias_ax.plot(times, empty, **style("estimate", label=BIAS_ESTIMATE_LABEL))
     bias_ax.set_ylim(*BIAS_AXIS)
@@ -167,6 +174,15 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
                       f"{end_error:+.0f} cm off at {scenario.duration:g} s", fontsize=10)
 
 
+def describe_bias(*, bias: float, sigma_a: float, sigma_v: float) -> str:
+    """What :func:`draw_bias` shows at these slider values (its alt text)."""
+    return (f"First {WINDOW:g} s of one run with an acceleration signal biased by "
+            f"b = {bias:g} cm/s² and noise σ_a = {sigma_a:.3g} cm/s², vision at "
+            f"σ_v = {sigma_v:.1f} cm. Left: the bias estimate with its ±2σ band approaching "
+            f"the true bias; right: true path, vision, filtered estimate and dead reckoning "
+            f"drifting away.")
+
+
 def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
     """Sliders for b (cm/s²), σ_a (cm/s², log scale) and σ_v (cm) over :func:`draw_bias`.
 
@@ -195,4 +211,5 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
         sliders,
         partial(draw_bias, scenario=scenario, noise=noise),
         figsize=(10.0, 4.6),
+        describe=describe_bias,
     )

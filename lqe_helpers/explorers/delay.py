@@ -17,10 +17,10 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.patches import Patch
+from matplotlib.patches import Patch, Rectangle
 
 from .. import experiments
-from ..explorer import Explorer, float_slider, reuse_panels, starting_value
+from ..explorer import DATA_UNDER_LINES, Explorer, float_slider, reuse_panels, starting_value
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -45,7 +45,7 @@ _LINES = {
 }
 _SPAN = "nothing-yet"
 _SPAN_STYLE = {"color": COLORS["vision"], "alpha": 0.2, "linewidth": 0, "gid": _SPAN,
-               "zorder": 0}
+               "zorder": DATA_UNDER_LINES}
 #: Smallest y half-range (in units of the flight's amplitude) of each axes.
 _FLOORS = (1.5, 0.8)
 
@@ -55,6 +55,7 @@ class _Panels(NamedTuple):
 
     axes: tuple[Axes, Axes]
     lines: dict[str, Line2D]
+    spans: tuple[Rectangle, Rectangle]
 
 
 def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
@@ -121,15 +122,19 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
         if np.any(np.isfinite(values)):
             index = _LINES[gid][0]
             largest[index] = max(largest[index], float(np.nanmax(np.abs(values))))
-    for ax, floor, extent in zip(panels.axes, _FLOORS, largest, strict=True):
+    for ax, span, floor, extent in zip(panels.axes, panels.spans, _FLOORS, largest,
+                                       strict=True):
         # Fixed limits while everything fits, so small changes stay comparable; wider
         # ones when a long extrapolation overshoots, so the overshoot stays visible.
-        limit = max(floor * scenario.amplitude, 1.08 * extent)
-        ax.set_ylim(-limit, limit)
-        for patch in [p for p in ax.patches if p.get_gid() == _SPAN]:
-            patch.remove()
-        if steps > 0:
-            ax.axvspan(0.0, steps * scenario.dt, **_SPAN_STYLE)
+        # Set only when they change: the explorer then repaints just the data.
+        # Rounded up to half the amplitude, so the limits change only in steps.
+        step = scenario.amplitude / 2
+        limit = step * math.ceil(max(floor * scenario.amplitude, 1.08 * extent) / step)
+        if ax.get_ylim() != (-limit, limit):
+            ax.set_ylim(-limit, limit)
+        # The same span every time, resized (a new one would force a full repaint).
+        span.set_width(steps * scenario.dt)
+        span.set_visible(steps > 0)
     figure.suptitle(
         f"delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps).   MSE of this run: "
         f"delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
@@ -154,13 +159,17 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     top, bottom = axes
     top.set_ylabel("position (cm)")
     bottom.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
+    # Below the lines (zorder 1.7): a fixed text under them stays in the cached layer.
     bottom.text(0.99, 0.95, "error = estimate − true position", transform=bottom.transAxes,
-                ha="right", va="top", fontsize=8)
+                ha="right", va="top", fontsize=8, zorder=1.7)
     bottom.set_xlabel("time (s)")
     bottom.set_ylabel("error (cm)")
     bottom.set_xlim(0.0, min(WINDOW, scenario.duration))
     figure.align_ylabels(axes)
-    return _Panels((top, bottom), lines)
+    spans = tuple(ax.axvspan(0.0, 0.0, **_SPAN_STYLE) for ax in axes)
+    for ax in axes:
+        ax.set_xlim(0.0, min(WINDOW, scenario.duration))  # axvspan would widen them
+    return _Panels((top, bottom), lines, spans)
 
 
 def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
@@ -191,7 +200,17 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
         {"delay": slider},
         partial(_draw_on_grid, tracking=tracking),
         figsize=(9.0, 5.2),
+        describe=partial(describe_delay, scenario=scenario),
     )
+
+
+def describe_delay(*, delay: float, scenario: Scenario = DEFAULT) -> str:
+    """What :func:`draw_delay` shows at ``delay`` (its alt text); rounds to whole steps."""
+    shown = round(delay / scenario.dt) * scenario.dt
+    window = min(WINDOW, scenario.duration)
+    return (f"Position against time, 0–{window:g} s, with vision delayed by d = {shown:.2f} s: "
+            f"true path, delayed readings, the delayed estimate and the compensated "
+            f"prediction, with both estimates' errors below.")
 
 
 def _draw_on_grid(figure: Figure, *, delay: float, tracking: experiments.Tracking) -> None:

@@ -20,7 +20,14 @@ from matplotlib.text import Annotation
 
 from .. import experiments, validation
 from ..cue_combination import reliability_weights
-from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels, starting_value
+from ..explorer import (
+    DATA_UNDER_LINES,
+    Explorer,
+    float_slider,
+    pin_axis_labels,
+    reuse_panels,
+    starting_value,
+)
 from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
 from ._trial import (
@@ -178,13 +185,14 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
     band = errors.collections[-1]
     band.set_gid(_BAND)
+    band.set_zorder(DATA_UNDER_LINES)
     figure.legend(handles=[*legend_handles(trial, _LINES), band], loc="upper left",
                   bbox_to_anchor=(0.07, 0.945), ncol=3, fontsize=8, markerscale=2.5)
     errors.set_yticks([-2, 0, 2])
 
     names = ("vision", "proprioception")
     bars = shares.bar([0, 1], [0.5, 0.5], color=[COLORS[name] for name in names],
-                      edgecolor="black", linewidth=0.6)
+                      edgecolor="black", linewidth=0.6, zorder=DATA_UNDER_LINES)
     texts = []
     for bar, name in zip(bars, names, strict=True):
         bar.set_gid(f"weight {name}")
@@ -198,6 +206,14 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     shares.set_title("weights ∝ reliability 1/σ²", fontsize=10)
     pin_axis_labels(figure)
     return _Panels(trial, band, tuple(bars), tuple(texts))
+
+
+def describe_fusion(*, sigma_v: float, sigma_p: float) -> str:
+    """What :func:`draw_fusion` shows at ``sigma_v`` and ``sigma_p`` (its alt text)."""
+    return (f"One trial at σ_v = {sigma_v:.2f} cm and σ_p = {sigma_p:.2f} cm. Top left: true "
+            f"position, both senses' readings, the vision-only and the fused estimate; bottom "
+            f"left: their errors with the fused filter's ±2 SD band; right: each sense's share "
+            f"of the position correction.")
 
 
 def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
@@ -222,4 +238,4 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
     }
     draw = partial(draw_fusion, scenario=scenario, noise=unit_noise(scenario))
     return Explorer("Vision alone against vision + proprioception", sliders, draw,
-                    figsize=(10.0, 5.0))
+                    figsize=(10.0, 5.0), describe=describe_fusion)

@@ -25,7 +25,14 @@ from matplotlib.text import Text
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..explorer import Explorer, log_slider, reuse_panels, starting_value
+from ..explorer import (
+    DATA_UNDER_LINES,
+    Explorer,
+    log_slider,
+    reuse_panels,
+    set_ylim_in_steps,
+    starting_value,
+)
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 
@@ -70,7 +77,8 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     bands, estimates = [], []
     for column, ax in enumerate((position_ax, velocity_ax)):
         bands.append(ax.fill_between(times, empty, empty, color=COLORS["estimate"],
-                                     alpha=0.15, linewidth=0, label=BAND_LABEL))
+                                     alpha=0.15, linewidth=0, label=BAND_LABEL,
+                                     zorder=DATA_UNDER_LINES))
         ax.plot(times, truth[:, column], label=TRUTH_LABEL, **style("truth"))
         estimates.append(ax.plot(times, empty, label=ESTIMATE_LABEL, **style("estimate"))[0])
         ax.set_xlim(times[0], times[-1])
@@ -138,11 +146,20 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     low = min(measured.min(), estimates[:, 0].min(), -scenario.amplitude)
     high = max(measured.max(), estimates[:, 0].max(), scenario.amplitude)
     margin = 0.05 * (high - low)
-    panels.axes[0].set_ylim(low - margin, high + margin)
+    # In steps of half the amplitude: most slider moves keep the axis as it was.
+    set_ylim_in_steps(panels.axes[0], low - margin, high + margin, scenario.amplitude / 2)
     panels.title.set_text(
         f"P0 = {p0_variance:.3g} · I: position MSE of this run {early_mse:.2f} cm² in the "
         f"first {scenario.burn_in:g} s, {late_mse:.2f} cm² after"
     )
+
+
+def describe_initial_covariance(*, p0_variance: float, scenario: Scenario = DEFAULT) -> str:
+    """What :func:`draw_initial_covariance` shows at ``p0_variance`` (its alt text)."""
+    seconds = (shown_steps(scenario) - 1) * scenario.dt
+    return (f"The first {seconds:g} s of vision-only tracking with P0 = {p0_variance:.3g} · I. "
+            f"Left: true position, noisy vision and the estimate with its ±2σ band; right: "
+            f"true and estimated velocity with its ±2σ band.")
 
 
 def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
@@ -175,4 +192,5 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
         "The start of vision-only tracking as the initial covariance P0 changes",
         {"p0_variance": slider},
         partial(draw_initial_covariance, scenario=scenario, noise=noise),
+        describe=partial(describe_initial_covariance, scenario=scenario),
     )

@@ -184,6 +184,14 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     return _Panels(trial, marker)
 
 
+def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFAULT) -> str:
+    """What :func:`draw_noisier_proprioception` shows at ``sigma_p`` (its alt text)."""
+    return (f"One trial at σ_v = {scenario.sigma_v:g} cm and σ_p = {sigma_p:.1f} cm. Left: "
+            f"true position, the vision-only and the fused estimate, and their errors; right: "
+            f"the fused filter's steady-state position variance against σ_p, with "
+            f"σ_p = {sigma_p:.1f} cm marked, below the vision-only level.")
+
+
 def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
     """A σ_p slider over vision-only and fused tracking of one fixed trial.
 
@@ -196,4 +204,5 @@ def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
                                        readout_format=".1f")}
     draw = partial(draw_noisier_proprioception, scenario=scenario, noise=unit_noise(scenario))
     return Explorer("How much does a noisier proprioception help?", sliders, draw,
-                    figsize=(10.0, 5.0))
+                    figsize=(10.0, 5.0),
+                    describe=partial(describe_noisier_proprioception, scenario=scenario))

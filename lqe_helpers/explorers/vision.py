@@ -23,7 +23,14 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments, validation
-from ..explorer import Explorer, float_slider, reuse_panels, starting_value
+from ..explorer import (
+    DATA_UNDER_LINES,
+    Explorer,
+    float_slider,
+    reuse_panels,
+    set_ylim_in_steps,
+    starting_value,
+)
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 
@@ -54,7 +61,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panel:
     times = scenario.times
     vision, = ax.plot(times, np.zeros_like(times), label=VISION_LABEL, **style("vision"))
     band = ax.fill_between(times, times, times, color=COLORS["estimate"], alpha=0.15,
-                           linewidth=0, label=BAND_LABEL)
+                           linewidth=0, label=BAND_LABEL, zorder=DATA_UNDER_LINES)
     ax.plot(times, scenario.truth[:, 0], label=TRUTH_LABEL, **style("truth"))
     estimate, = ax.plot(times, np.zeros_like(times), label=ESTIMATE_LABEL, **style("estimate"))
     ax.set_xlim(0.0, scenario.duration)
@@ -108,12 +115,19 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
     low = min(measured.min(), (estimate - 2 * std).min(), -scenario.amplitude)
     high = max(measured.max(), (estimate + 2 * std).max(), scenario.amplitude)
     margin = 0.05 * (high - low)
-    panel.ax.set_ylim(low - margin, high + margin)
+    # In steps of half the amplitude: most slider moves keep the axis as it was.
+    set_ylim_in_steps(panel.ax, low - margin, high + margin, scenario.amplitude / 2)
     panel.ax.set_title(
         f"σ_v = {sigma_v:.1f} cm: MSE after {scenario.burn_in:g} s, this run: "
         f"raw vision {raw_mse:.2f} cm², filtered {filtered_mse:.2f} cm²",
         fontsize=10,
     )
+
+
+def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT) -> str:
+    """One sentence saying what :func:`draw_vision` shows at ``sigma_v`` (its alt text)."""
+    return (f"Position against time, 0–{scenario.duration:g} s: true path, noisy vision at "
+            f"σ_v = {sigma_v:.1f} cm and the filtered estimate with its ±2σ band.")
 
 
 def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
@@ -145,4 +159,5 @@ def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
         "Vision-only tracking as the vision noise σ_v changes",
         {"sigma_v": slider},
         partial(draw_vision, scenario=scenario, noise=noise),
+        describe=partial(describe_vision, scenario=scenario),
     )

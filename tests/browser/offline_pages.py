@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from playwright.sync_api import Browser, Route
+    from playwright.sync_api import Browser, Page, Route
 
 #: Bound of a page load, ms.
 LOAD_MS = 30_000
@@ -78,3 +80,45 @@ def open_offline(browser: Browser, path: Path, screenshot: Path | None = None) -
     finally:
         context.close()
     return OfflinePage(path, images, blocked, links)
+
+
+#: WCAG 1.4.10 reflow: 1280 CSS px at 200 % zoom is a 640 CSS px wide viewport, drawn
+#: with two device pixels per CSS pixel.
+ZOOM_200_VIEWPORT = {"width": 640, "height": 800}
+ZOOM_200_SCALE = 2
+#: A Firefox user agent: MathJax then takes the path it takes in Firefox (native MathML).
+FIREFOX_USER_AGENT = "Mozilla/5.0 (X11; Linux x86_64; rv:128.0) Gecko/20100101 Firefox/128.0"
+
+
+@contextmanager
+def offline_page(browser: Browser, path: Path, *, viewport: dict[str, int] | None = None,
+                 device_scale_factor: float = 1, user_agent: str | None = None,
+                 blocked: list[str] | None = None) -> Iterator[Page]:
+    """``path`` (file://) loaded in a fresh context with the network cut; closed after.
+
+    Requests that try to leave the machine are refused and, if ``blocked`` is given,
+    recorded there as "resource-type URL".
+    """
+    extra = {"user_agent": user_agent} if user_agent else {}
+    context = browser.new_context(offline=True, viewport=viewport or {"width": 1200,
+                                                                      "height": 900},
+                                  device_scale_factor=device_scale_factor, **extra)
+
+    def cut(route: Route) -> None:
+        request = route.request
+        if request.url.startswith(("http:", "https:", "ws:", "wss:", "ftp:")):
+            if blocked is not None:
+                blocked.append(f"{request.resource_type} {request.url}")
+            route.abort("internetdisconnected")
+        else:
+            route.continue_()
+
+    try:
+        context.route("**/*", cut)
+        page = context.new_page()
+        # Not "load": that waits for every script MathJax adds (fonts, its output code);
+        # a caller waits for what it needs (MathJax's end of typesetting, say).
+        page.goto(path.resolve().as_uri(), wait_until="domcontentloaded", timeout=LOAD_MS)
+        yield page
+    finally:
+        context.close()

@@ -1,0 +1,168 @@
+"""Slider latency in a real browser: key press on a slider → new picture shown.
+
+Run: ``.venv/bin/python benchmarks/bench_browser.py`` (needs Chromium, e.g. Debian's
+``chromium`` package, and Playwright for Python; prints a reason and exits 0 without).
+
+For every explorer of the pack, a one-cell notebook showing it is opened in
+JupyterLab in headless Chromium (the same server and helpers as ``tests/browser``)
+and run. Then the handle of its first slider is pressed End and Home in turn; the
+time from the key press to the explorer's image holding a new, loaded picture is
+measured in the page (``performance.now()`` at the key press, the image's ``load``
+event). It covers the whole round trip: the widget message to the kernel, the
+redraw, the PNG back over the websocket and its decoding. The median per explorer
+is printed; there is no pass/fail (issue 12's target: <= 120 ms on a quiet 2-core
+machine).
+"""
+
+from __future__ import annotations
+
+import shutil
+import statistics
+import sys
+import tempfile
+from pathlib import Path
+
+import nbformat
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "browser"))
+
+# The shared helpers live beside the browser tests.
+import lab_driver
+from lab_driver import (
+    CHROMIUM_ARGS,
+    REPO_ROOT,
+    LabServer,
+    clear_and_run_all,
+    explorers,
+    open_notebook,
+)
+
+#: (name, module, factory) of every explorer in the pack.
+EXPLORERS = [
+    ("00 background", "lqe_helpers.explorers.background", "explore_background"),
+    ("01 vision only", "lqe_helpers.explorers.vision", "explore_vision"),
+    ("02 initial covariance", "lqe_helpers.explorers.initial_covariance",
+     "explore_initial_covariance"),
+    ("03 fusion", "lqe_helpers.explorers.fusion", "explore_fusion"),
+    ("04 noisier proprioception", "lqe_helpers.explorers.noisier_proprioception",
+     "explore_noisier_proprioception"),
+    ("05 sensory delay", "lqe_helpers.explorers.delay", "explore_delay"),
+    ("06 bias and input", "lqe_helpers.explorers.bias", "explore_bias"),
+]
+#: Key presses timed per explorer (after two untimed ones that warm the cache).
+PRESSES = 10
+WARM_UP = 2
+TARGET_MS = 120.0
+#: Longest wait (ms) for JupyterLab's page and widgets to appear.
+PAGE_TIMEOUT_MS = 180_000
+
+#: In the page: press-to-picture time (ms) of one key press on the slider handle.
+#: Resolves when the image's src has changed and the new picture has loaded.
+_TIMED_PRESS_JS = """
+([handle, image, key]) => new Promise((resolve, reject) => {
+    const before = image.src;
+    const start = performance.now();
+    const done = () => {
+        if (image.src !== before && image.complete && image.naturalWidth > 0) {
+            observer.disconnect();
+            image.removeEventListener("load", done);
+            resolve(performance.now() - start);
+        }
+    };
+    const observer = new MutationObserver(done);
+    observer.observe(image, {attributes: true, attributeFilter: ["src"]});
+    image.addEventListener("load", done);
+    setTimeout(() => { observer.disconnect(); reject(new Error("no new picture in 30 s")); },
+               30000);
+    handle.focus();
+    handle.dispatchEvent(new KeyboardEvent("keydown", {key, bubbles: true}));
+})
+"""
+
+
+def find_chromium() -> str | None:
+    """Path of a Chromium executable, or None."""
+    for name in ("chromium", "chromium-browser"):
+        found = shutil.which(name)
+        if found:
+            return found
+    return "/usr/bin/chromium" if Path("/usr/bin/chromium").is_file() else None
+
+
+def write_notebooks(root: Path) -> list[Path]:
+    """One notebook per explorer, each a single cell displaying it."""
+    paths = []
+    for number, (_, module, factory) in enumerate(EXPLORERS):
+        source = f"from {module} import {factory}\n\n{factory}()"
+        notebook = nbformat.v4.new_notebook(
+            cells=[nbformat.v4.new_code_cell(source)],
+            metadata={"kernelspec": {"name": "python3", "display_name": "Python 3 (ipykernel)",
+                                     "language": "python"}})
+        path = root / f"bench_{number}.ipynb"
+        nbformat.write(notebook, path)
+        paths.append(path)
+    return paths
+
+
+def time_presses(page, panel) -> list[float]:
+    """Press-to-picture times (ms) of the first slider of the notebook's explorer."""
+    (view,) = explorers(panel)
+    handle = view.sliders[0].locator(".noUi-handle").element_handle()
+    image = view.image.element_handle()
+    times = []
+    for press in range(WARM_UP + PRESSES):
+        key = "End" if press % 2 == 0 else "Home"
+        elapsed = page.evaluate(_TIMED_PRESS_JS, [handle, image, key])
+        if press >= WARM_UP:
+            times.append(float(elapsed))
+    return times
+
+
+def main() -> int:
+    chromium = find_chromium()
+    try:
+        from playwright.sync_api import sync_playwright
+    except ImportError as error:
+        print(f"browser benchmark not run: Playwright for Python is missing ({error})")
+        return 0
+    if chromium is None:
+        print("browser benchmark not run: no Chromium executable (install Debian's 'chromium')")
+        return 0
+    # A benchmark may run on a busy machine: wait longer for pages than the tests do.
+    lab_driver.UI_MS = max(lab_driver.UI_MS, PAGE_TIMEOUT_MS)
+    with tempfile.TemporaryDirectory(prefix="lqe-bench-browser-") as scratch:
+        root, state = Path(scratch) / "root", Path(scratch) / "state"
+        root.mkdir()
+        state.mkdir()
+        notebooks = write_notebooks(root)
+        server = LabServer.start(root, state, repo_root=REPO_ROOT)
+        try:
+            with sync_playwright() as playwright:
+                browser = playwright.chromium.launch(
+                    executable_path=chromium, headless=True, args=list(CHROMIUM_ARGS))
+                try:
+                    print(f"Slider key press -> new picture shown in JupyterLab (Chromium), "
+                          f"median of {PRESSES} presses (target <= {TARGET_MS:.0f} ms on a "
+                          f"quiet 2-core machine; no pass/fail)")
+                    for (name, _, _), notebook in zip(EXPLORERS, notebooks, strict=True):
+                        context = browser.new_context(viewport={"width": 1400, "height": 1000})
+                        try:
+                            page = context.new_page()
+                            panel = open_notebook(page, server, notebook.name,
+                                                  workspace=notebook.stem)
+                            clear_and_run_all(page, panel)
+                            times = time_presses(page, panel)
+                        finally:
+                            context.close()
+                            server.shutdown_kernels()
+                        print(f"  {name:27s} {statistics.median(times):7.1f} ms  "
+                              f"(min {min(times):.1f}, max {max(times):.1f})")
+                finally:
+                    browser.close()
+        finally:
+            server.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,385 @@
+"""How a handout page looks and reads: offline maths, described figures, accessible markup.
+
+:func:`handout_exporter` is the nbconvert ``HTMLExporter`` (lab template) that renders one
+notebook as a handout page; :func:`mathjax_files` lists the MathJax files the pages load,
+which the build copies once into the handouts folder (``mathjax/``), so the pages typeset
+their equations with no network and no third-party script.
+
+Maths: MathJax 2.7 as shipped in the ``jupyter-server-mathjax`` wheel (the copy Jupyter's
+own tools serve), TeX input with the AMS extensions, SVG output. SVG output draws glyphs
+from JavaScript font files loaded with ``<script>`` tags, so it needs no web-font download:
+a browser that refuses fonts from ``file:`` URLs in another folder (Firefox's file-origin
+rule) still shows every equation. The AssistiveMML extension puts a MathML copy of each
+equation beside the picture for screen readers. Only the files these pages can load are
+copied (:data:`MATHJAX_PARTS`).
+
+Figures: a figure shown with :func:`lqe_helpers.plotting.show_figure` arrives as an
+``<img>`` whose ``alt`` is its description (``text/html``, preferred) and as ``image/png``
+with the description in ``metadata["image/png"]["alt"]``, which the template here writes
+into the ``alt`` attribute (nbconvert's lab template drops it). A PNG output with no
+description gets nbconvert's :data:`GENERIC_ALT`, which the browser audit refuses;
+:func:`undescribed_figures` lists such figures for the build to report.
+
+Markup: colours of code, prompts and links raised to WCAG 2.1 AA contrast (4.5:1), a
+visible focus ring, no "¶" anchor links (link text that says nothing), and a layout that
+reflows at 320 CSS px: text wraps; code blocks, wide tables and wide equations scroll in
+their own box.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import nbformat
+from jinja2 import DictLoader
+from nbconvert.exporters import HTMLExporter
+from nbconvert.preprocessors import Preprocessor
+from traitlets.config import Config
+
+#: Folder of the MathJax copy inside the handouts folder.
+MATHJAX_DIR = "mathjax"
+#: MathJax's combined configuration the pages load (TeX input; HTML-CSS and native MathML
+#: output jax included in the one file).
+MATHJAX_CONFIG_NAME = "TeX-AMS-MML_HTMLorMML-full"
+#: Files and folders of the MathJax distribution the pages can load, relative to its
+#: root (``jupyter_server_mathjax/static``): the loader, the combined configuration, the
+#: MathML element jax, the TeX and accessibility extensions, the HTML-CSS output's
+#: STIX-Web font data and web fonts (the only font the wheel ships), and the licence.
+MATHJAX_PARTS = (
+    "LICENSE",
+    "MathJax.js",
+    f"config/{MATHJAX_CONFIG_NAME}.js",
+    "jax/element/mml",
+    "jax/output/HTML-CSS/autoload",
+    "jax/output/HTML-CSS/fonts/STIX-Web",
+    "fonts/HTML-CSS/STIX-Web/woff",
+    "extensions/AssistiveMML.js",
+    "extensions/MathEvents.js",
+    "extensions/MathZoom.js",
+    "extensions/toMathML.js",
+    "extensions/TeX",
+)
+#: What an HTML page may show from a display bundle, best first. The widget view is
+#: not in the list: with no widget manager it could only render as a placeholder.
+DISPLAY_PRIORITY = [
+    "text/html",
+    "text/markdown",
+    "image/svg+xml",
+    "text/latex",
+    "image/png",
+    "image/jpeg",
+    "text/plain",
+]
+#: The alt text nbconvert gives an image that has none: a page must never show it.
+GENERIC_ALT = "No description has been provided for this image"
+#: The mimetypes a figure arrives as, and whose description (``alt``) a page needs.
+FIGURE_MIMETYPES = ("image/png", "image/jpeg")
+
+_TEMPLATE_NAME = "lqe_handout.html.j2"
+
+_MATHJAX_CONFIG = r"""
+MathJax.Hub.Config({
+  TeX: {equationNumbers: {autoNumber: "AMS", useLabelIds: true}},
+  tex2jax: {
+    inlineMath: [["$", "$"], ["\\(", "\\)"]],
+    displayMath: [["$$", "$$"], ["\\[", "\\]"]],
+    processEscapes: true,
+    processEnvironments: true
+  },
+  "HTML-CSS": {
+    availableFonts: [], preferredFont: null, webFont: "STIX-Web", imageFont: null,
+    linebreaks: {automatic: true}
+  },
+  MMLorHTML: {prefer: {Firefox: "MML", other: "HTML"}},
+  menuSettings: {assistiveMML: true},
+  showMathMenu: false,
+  displayAlign: "center",
+  messageStyle: "none"
+});
+"""
+
+# WCAG 2.1 AA: text contrast >= 4.5:1 on the page's white and on the code cells' grey
+# (#f5f5f5); every colour below is >= 4.5:1 on both (checked in tests/test_handout_pages.py).
+_CSS = r"""
+:root {
+  --jp-content-link-color: #0b57d0;
+  --jp-cell-inprompt-font-color: #1f5f99;
+  --jp-cell-outprompt-font-color: #a3321a;
+  --jp-cell-editor-background: #f5f5f5;
+  --jp-cell-prompt-not-active-opacity: 1;
+  --jp-cell-prompt-not-active-font-color: #595959;
+  --jp-content-font-color2: #4a4a4a;
+  --jp-content-font-color3: #595959;
+  --jp-mirror-editor-keyword-color: #006b00;
+  --jp-mirror-editor-atom-color: #0b4fa3;
+  --jp-mirror-editor-number-color: #006b00;
+  --jp-mirror-editor-def-color: #00508a;
+  --jp-mirror-editor-variable-color: #212121;
+  --jp-mirror-editor-variable-2-color: #1f4f7a;
+  --jp-mirror-editor-variable-3-color: #00698a;
+  --jp-mirror-editor-punctuation-color: #0b4fa3;
+  --jp-mirror-editor-property-color: #0b4fa3;
+  --jp-mirror-editor-operator-color: #8f1f8f;
+  --jp-mirror-editor-comment-color: #3d6b6b;
+  --jp-mirror-editor-string-color: #a31515;
+  --jp-mirror-editor-string-2-color: #8a3b00;
+  --jp-mirror-editor-meta-color: #8f1f8f;
+  --jp-mirror-editor-qualifier-color: #555555;
+  --jp-mirror-editor-builtin-color: #006b00;
+  --jp-mirror-editor-bracket-color: #616161;
+  --jp-mirror-editor-tag-color: #006b00;
+  --jp-mirror-editor-attribute-color: #00508a;
+  --jp-mirror-editor-header-color: #0b4fa3;
+  --jp-mirror-editor-quote-color: #006b00;
+  --jp-mirror-editor-link-color: #0b4fa3;
+  --jp-mirror-editor-error-color: #c40000;
+  --jp-mirror-editor-hr-color: #6b6b6b;
+}
+.jp-RenderedHTMLCommon a, nav.lqe-nav a { color: var(--jp-content-link-color); }
+a:focus-visible {
+  outline: 3px solid #0b57d0; outline-offset: 2px; border-radius: 2px;
+}
+/* Reflow (WCAG 1.4.10): the text wraps at any width; code, wide tables and wide
+   equations scroll inside their own box, never the page. */
+body { overflow-wrap: break-word; }
+main { min-width: 0; }
+.jp-Cell, .jp-Cell-inputWrapper, .jp-Cell-outputWrapper, .jp-InputArea, .jp-OutputArea,
+.jp-OutputArea-child, .jp-OutputArea-output, .jp-RenderedHTMLCommon { min-width: 0; }
+.jp-InputArea, .jp-OutputArea-output pre, .jp-RenderedHTMLCommon pre,
+.jp-RenderedHTMLCommon table { overflow-x: auto; max-width: 100%; }
+.jp-RenderedHTMLCommon table { display: block; }
+.jp-RenderedHTMLCommon img, .jp-RenderedImage img { max-width: 100%; height: auto; }
+.MathJax_Display { overflow-x: auto; overflow-y: hidden; max-width: 100%; }
+@media (max-width: 760px) {
+  .jp-InputPrompt, .jp-OutputPrompt { display: none; }
+  .jp-Notebook { padding: 4px; }
+}
+nav.lqe-nav {
+  display: flex; flex-wrap: wrap; justify-content: space-between; gap: 0.5em 1em;
+  max-width: 1100px; margin: 0.5em auto; padding: 0.4em 1em;
+  font-family: var(--jp-ui-font-family); font-size: 0.95em;
+  border-bottom: 1px solid var(--jp-border-color2);
+}
+nav.lqe-nav.lqe-nav-bottom { border-bottom: 0; border-top: 1px solid var(--jp-border-color2); }
+figure.lqe-explorer { margin: 0; }
+figure.lqe-explorer img { max-width: 100%; height: auto; }
+figure.lqe-explorer figcaption { color: var(--jp-content-font-color2); margin-top: 0.3em; }
+"""
+
+_TEMPLATE = r"""
+{%- extends 'index.html.j2' -%}
+
+{%- macro lqe_nav(nav, where) -%}
+{%- if nav -%}
+<nav class="lqe-nav lqe-nav-{{ where }}" aria-label="Handout pages ({{ where }})">
+  <span>{%- if nav.previous -%}
+    <a rel="prev" href="{{ nav.previous.href }}">&larr; Previous: {{ nav.previous.title | e }}</a>
+  {%- endif -%}</span>
+  <a href="{{ nav.index }}">All handout pages</a>
+  <span>{%- if nav.next -%}
+    <a rel="next" href="{{ nav.next.href }}">Next: {{ nav.next.title | e }} &rarr;</a>
+  {%- endif -%}</span>
+</nav>
+{%- endif -%}
+{%- endmacro -%}
+
+{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
+{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
+{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
+
+{%- block html_head_js_mathjax -%}
+{%- if resources.mathjax_url -%}
+<script type="text/x-mathjax-config">{{ resources.lqe_mathjax_config }}</script>
+<script async src="{{ resources.mathjax_url | e }}"></script>
+{%- endif -%}
+{%- endblock html_head_js_mathjax -%}
+
+{#- After the lab theme's CSS, so the colours here win. -#}
+{%- block html_head_css -%}
+<style type="text/css">{{ resources.lqe_css }}</style>
+{%- endblock html_head_css -%}
+
+{%- block body_header -%}
+{%- if resources.theme == 'dark' -%}
+<body class="jp-Notebook" data-jp-theme-light="false" data-jp-theme-name="JupyterLab Dark">
+{%- else -%}
+<body class="jp-Notebook" data-jp-theme-light="true" data-jp-theme-name="JupyterLab Light">
+{%- endif %}
+{{ lqe_nav(resources.lqe_nav, 'top') }}
+<main>
+{%- endblock body_header -%}
+
+{%- block body_footer -%}
+</main>
+{{ lqe_nav(resources.lqe_nav, 'bottom') }}
+</body>
+{%- endblock body_footer -%}
+
+{% block data_png scoped %}
+<div class="jp-RenderedImage jp-OutputArea-output {{ extra_class }}">
+{%- set alt = (output | get_metadata('alt', 'image/png') or '') | trim -%}
+<img src="data:image/png;base64,{{ output.data['image/png'] | escape_html }}"
+{%- if alt %} alt="{{ alt | escape_html }}"{% endif %}>
+</div>
+{%- endblock data_png %}
+
+{% block data_jpg scoped %}
+<div class="jp-RenderedImage jp-OutputArea-output {{ extra_class }}">
+{%- set alt = (output | get_metadata('alt', 'image/jpeg') or '') | trim -%}
+<img src="data:image/jpeg;base64,{{ output.data['image/jpeg'] | escape_html }}"
+{%- if alt %} alt="{{ alt | escape_html }}"{% endif %}>
+</div>
+{%- endblock data_jpg %}
+"""
+
+
+def mathjax_root() -> Path:
+    """The MathJax distribution shipped in the ``jupyter-server-mathjax`` wheel."""
+    import jupyter_server_mathjax
+
+    return Path(jupyter_server_mathjax.__file__).parent / "static"
+
+
+def mathjax_files(root: Path | None = None) -> dict[str, Path]:
+    """The MathJax files a handout folder needs, by their path inside ``mathjax/``.
+
+    Parameters
+    ----------
+    root : Path, optional
+        Root of the MathJax distribution (default :func:`mathjax_root`).
+
+    Returns
+    -------
+    dict of str to Path
+        ``"jax/output/SVG/jax.js"`` (POSIX path relative to :data:`MATHJAX_DIR`) →
+        the file to copy, for every file of :data:`MATHJAX_PARTS`, sorted.
+
+    Raises
+    ------
+    FileNotFoundError
+        If a part is missing from ``root`` (a MathJax copy of another layout).
+    """
+    root = mathjax_root() if root is None else Path(root)
+    files = {}
+    for part in MATHJAX_PARTS:
+        path = root / part
+        if path.is_file():
+            files[part] = path
+        elif path.is_dir():
+            files.update({found.relative_to(root).as_posix(): found
+                          for found in path.rglob("*") if found.is_file()})
+        else:
+            raise FileNotFoundError(f"MathJax part {part!r} is missing from {root}")
+    return dict(sorted(files.items()))
+
+
+def mathjax_url(depth: int = 0) -> str:
+    """The relative URL that loads the local MathJax from a page ``depth`` folders down.
+
+    ``0`` for a page beside ``mathjax/``
+    (``mathjax/MathJax.js?config=TeX-AMS-MML_HTMLorMML-full``), ``1`` for a page in
+    ``prose/`` (``../mathjax/MathJax.js?config=…``).
+    """
+    if isinstance(depth, bool) or not isinstance(depth, int) or depth < 0:
+        raise ValueError(f"depth must be a whole number >= 0, got {depth!r}")
+    return "../" * depth + f"{MATHJAX_DIR}/MathJax.js?config={MATHJAX_CONFIG_NAME}"
+
+
+def figure_description(output: nbformat.NotebookNode | dict) -> str | None:
+    """The description a figure output carries for its page, or ``None``.
+
+    ``metadata[mimetype]["alt"]`` (what :func:`lqe_helpers.plotting.show_figure` writes)
+    for a PNG or JPEG output, stripped; ``None`` if it is missing or blank. An output
+    shown as ``text/html`` (an ``<img alt>`` of its own) is not a bare figure: ``None``.
+    """
+    data = output.get("data", {})
+    metadata = output.get("metadata", {})
+    for mimetype in FIGURE_MIMETYPES:
+        if mimetype in data:
+            alt = (metadata.get(mimetype) or {}).get("alt") or metadata.get("alt")
+            return alt.strip() if isinstance(alt, str) and alt.strip() else None
+    return None
+
+
+def undescribed_figures(notebook: nbformat.NotebookNode) -> list[str]:
+    """Where ``notebook`` shows a figure its page cannot describe: ``"cell N"`` per figure.
+
+    A figure is a display output that the page shows as a picture (PNG or JPEG, no
+    ``text/html`` before it in :data:`DISPLAY_PRIORITY`) with no description in its
+    metadata. ``N`` counts every cell (markdown included) from 0.
+    """
+    found = []
+    for index, cell in enumerate(notebook.cells):
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            shown = next((mime for mime in DISPLAY_PRIORITY if mime in data), None)
+            if shown in FIGURE_MIMETYPES and figure_description(output) is None:
+                found.append(f"cell {index}")
+    return found
+
+
+class _PageResources(Preprocessor):
+    """Put the page's MathJax configuration and CSS into the template's resources."""
+
+    def preprocess(self, nb: nbformat.NotebookNode,
+                   resources: dict) -> tuple[nbformat.NotebookNode, dict]:
+        resources["lqe_mathjax_config"] = _MATHJAX_CONFIG
+        resources["lqe_css"] = _CSS
+        return nb, resources
+
+
+def handout_exporter(*, code: bool = True, mathjax_url: str = "",
+                     preprocessors: Sequence[Preprocessor] = ()) -> HTMLExporter:
+    """The HTML exporter for handout pages.
+
+    Parameters
+    ----------
+    code : bool
+        Show the code cells' source (``False`` for the prose variant: markdown,
+        printed results and figures only, without prompts).
+    mathjax_url : str
+        URL that loads MathJax (``async``) as the page sees it, configuration query
+        included: :func:`mathjax_url` for the local copy; ``""`` (default) leaves
+        MathJax out, and the equations show as their LaTeX source.
+    preprocessors : sequence of Preprocessor
+        Further preprocessors, run after nbconvert's own (e.g. link rewriting).
+
+    Returns
+    -------
+    HTMLExporter
+        Lab template with the handout's overrides; ``resources`` passed to
+        ``from_notebook_node`` may carry ``lqe_nav`` (``index``, ``previous``,
+        ``next``: links of the page navigation).
+    """
+    config = Config()
+    config.NbConvertBase.display_data_priority = list(DISPLAY_PRIORITY)
+    config.HTMLExporter.embed_images = True
+    config.HTMLExporter.mathjax_url = mathjax_url
+    config.HTMLExporter.exclude_anchor_links = True
+    config.HTMLExporter.language_code = "en"
+    config.TagRemovePreprocessor.enabled = True
+    config.TagRemovePreprocessor.remove_cell_tags = {"remove-cell"}
+    config.TagRemovePreprocessor.remove_input_tags = {"remove-input"}
+    config.TagRemovePreprocessor.remove_all_outputs_tags = {"remove-output"}
+    if not code:
+        config.TemplateExporter.exclude_input = True
+        config.TemplateExporter.exclude_input_prompt = True
+        config.TemplateExporter.exclude_output_prompt = True
+    exporter = HTMLExporter(config=config, template_name="lab",
+                            extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
+    exporter.template_file = _TEMPLATE_NAME
+    exporter.register_preprocessor(_PageResources(), enabled=True)
+    for preprocessor in preprocessors:
+        exporter.register_preprocessor(preprocessor, enabled=True)
+    return exporter
+
+
+def mathjax_copy(root: Path | None = None) -> dict[str, bytes]:
+    """The MathJax copy for a handouts folder: ``"mathjax/…"`` → file content.
+
+    Every file of :func:`mathjax_files` under :data:`MATHJAX_DIR`, for the build to
+    write with its pages (about 1.9 MB: see :func:`mathjax_files`).
+    """
+    return {f"{MATHJAX_DIR}/{name}": path.read_bytes()
+            for name, path in mathjax_files(root).items()}

@@ -1,0 +1,308 @@
+"""The student pack: one zip a student unpacks and uses with ``make lab``.
+
+``python -m lqe_helpers.authoring.student_pack [--root .] [--out build/student-pack]``
+(or ``make student-pack``) writes ``lqe-student-pack.zip``. Unpacked, its folder
+``lqe-student-pack/`` holds:
+
+- ``notebooks/``: the student edition of every notebook (tasks as stubs, answers as
+  prompts; built as ``make student`` builds it, and refused for the same reasons);
+- ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/``. Those are the
+  instructor's tools (run notebooks, build handouts, the student edition, this pack,
+  the marking guide); nothing a student runs (notebooks, explorers, checks, ``make lab``,
+  ``make test``) imports them, and leaving them out keeps the pack to what students use;
+- ``README.md`` (with a first note saying this is the student pack), ``pyproject.toml``,
+  ``constraints.txt``;
+- ``Makefile``: the pack's own, generated from the course's Makefile by keeping its
+  variables and its ``$(BIN)/python``, ``$(STAMP)``, ``lab`` and ``clean`` rules word for
+  word (so ``make lab`` is identical) and replacing ``test``: it runs ``pytest tests``
+  (the unit tests and the structure checks below), without ruff and without nbval, which
+  would stop at the first unfinished task by design;
+- ``tests/``: the unit tests of the package, plus ``test_student_notebooks.py`` (the
+  structure of the student notebooks: valid, student tags only, a check after every core
+  task, imports that resolve) with its conventions in ``student_pack.json``. Tests for
+  the instructor's side (:data:`INSTRUCTOR_TESTS`, and any other test that imports
+  ``lqe_helpers.authoring`` or reads the worked notebooks) are left out;
+- ``STUDENT-PACK.md``: what the pack is, how to start, and what was left out.
+
+The marking guide is never in the pack. The zip is the same, byte for byte, for the same
+sources (fixed file times and order), and is written atomically into a folder the tool
+owns (:func:`lqe_helpers.authoring.files.write_output_folder`).
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+import re
+import zipfile
+from collections.abc import Sequence
+from pathlib import Path
+
+from lqe_helpers.authoring import student_edition as se
+from lqe_helpers.authoring.files import (
+    CommandLineParser,
+    read_notebook,
+    run_command,
+    source_notebooks,
+    write_output_folder,
+)
+
+#: Name of the tool in the output folder's manifest.
+TOOL_NAME = "student_pack"
+#: The folder a student gets when unpacking the zip.
+PACK_NAME = "lqe-student-pack"
+#: The zip written in the output folder.
+ZIP_NAME = f"{PACK_NAME}.zip"
+#: What the pack is, at its top level (also marks an unpacked folder as a student pack).
+MARKER_NAME = "STUDENT-PACK.md"
+#: Files copied from the top of the course folder as they are (the README gets a note).
+TOP_FILES = ("README.md", "pyproject.toml", "constraints.txt")
+#: Sub-packages of lqe_helpers that stay with the instructor.
+INSTRUCTOR_PACKAGES = ("authoring",)
+#: Tests (files or folders under tests/) of the instructor's side, left out of the pack.
+INSTRUCTOR_TESTS = ("browser", "test_notebook_files.py", "test_student_edition.py",
+                    "test_student_leaks.py", "test_student_pack.py", "test_marking_guide.py",
+                    "test_handouts.py", "test_notebook_runner.py")
+#: A test that mentions these needs what the pack leaves out (authoring, worked notebooks).
+INSTRUCTOR_ONLY = re.compile(r"lqe_helpers\.authoring|from lqe_helpers import authoring"
+                             r"|[\"']notebooks[\"']")
+#: Rules of the course Makefile the pack keeps word for word.
+KEPT_RULES = ("$(BIN)/python", "$(STAMP)", "lab", "clean")
+#: A rule's first line in a Makefile (not a variable assignment with ``:=``).
+RULE = re.compile(r"^([^\s#:=][^:=]*?)\s*::?(?!=)", re.MULTILINE)
+#: The pack's own ``test`` rule.
+PACK_TEST_RULE = """\
+# Student pack: the unit tests of lqe_helpers and the structure of the student notebooks
+# (valid, tags, a check after every core task, imports that resolve). The notebooks are
+# not run: their tasks are yours to write, and the checks in them tell you when each is right.
+test: $(STAMP)
+\t$(BIN)/python -m pytest tests $(PYTEST_ARGS)"""
+#: Where the files shipped only in the pack live in the course folder.
+PACK_FILES = Path(__file__).resolve().parent / "student_pack_files"
+#: The structure test shipped in the pack's tests/.
+STRUCTURE_TEST = "test_student_notebooks.py"
+#: Its conventions, written at build time from the student edition's definitions.
+CONVENTIONS_NAME = "student_pack.json"
+#: Notebooks whose core tasks must each have a check (the tutorial's questions).
+CHECKED_PREFIXES = ("01_", "02_", "03_", "04_", "05_")
+#: Date and time of every file in the zip (the earliest a zip can hold): same sources,
+#: same bytes.
+ZIP_TIME = (1980, 1, 1, 0, 0, 0)
+README_NOTE = (
+    "> **This is the student pack.** The notebooks in `notebooks/` are the student edition: "
+    "the tasks are yours to write and the answers yours to give. Start with `make lab`; "
+    f"see `{MARKER_NAME}` for what `make test` checks here.\n\n")
+
+
+def pack_makefile(course_makefile: str) -> str:
+    """The pack's Makefile, made from the course's.
+
+    Parameters
+    ----------
+    course_makefile : str
+        The course Makefile's text.
+
+    Returns
+    -------
+    str
+        Its paragraphs of comments and variables and its rules :data:`KEPT_RULES`,
+        word for word, in order; a ``.PHONY`` line for the pack's targets; and the
+        pack's ``test`` rule (:data:`PACK_TEST_RULE`). Other rules are left out.
+
+    Raises
+    ------
+    ValueError
+        If a kept rule is missing, or shares a paragraph with a rule that is not kept.
+    """
+    kept, found = [], set()
+    for paragraph in re.split(r"\n[ \t]*\n", course_makefile.strip("\n")):
+        targets = {target for match in RULE.finditer(paragraph)
+                   for target in match.group(1).split()}
+        if targets == {".PHONY"}:
+            kept.append(".PHONY: lab test clean")
+        elif not targets:
+            kept.append(paragraph)
+        elif targets <= set(KEPT_RULES):
+            kept.append(paragraph)
+            found |= targets
+            if "lab" in targets:  # the pack's test rule comes right after lab, as in the course
+                kept.append(PACK_TEST_RULE)
+        elif targets & set(KEPT_RULES):
+            raise ValueError(f"the Makefile's rules {sorted(targets)} share one paragraph; "
+                             f"put a blank line between kept rules {list(KEPT_RULES)} and others")
+    missing = [rule for rule in KEPT_RULES if rule not in found]
+    if missing:
+        raise ValueError(f"the Makefile has no rule {', '.join(missing)}, which the student "
+                         f"pack needs")
+    return "\n\n".join(kept) + "\n"
+
+
+def is_instructor_test(relative: Path, text: str | None) -> bool:
+    """Whether a file under ``tests/`` stays with the instructor (see the module docstring)."""
+    if relative.parts[0] in INSTRUCTOR_TESTS:
+        return True
+    return text is not None and bool(INSTRUCTOR_ONLY.search(text))
+
+
+def _files_under(folder: Path) -> list[Path]:
+    return sorted(path for path in folder.rglob("*")
+                  if path.is_file() and "__pycache__" not in path.parts
+                  and path.suffix not in {".pyc", ".pyo"})
+
+
+def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[str, bytes]:
+    """Every file of the student pack: path inside the pack → content.
+
+    Parameters
+    ----------
+    root : Path
+        The course folder (with ``notebooks/``, ``lqe_helpers/``, ``tests/``, the
+        Makefile and :data:`TOP_FILES`). Only read.
+    allow_without_solutions : bool
+        Build the edition of a notebook that has no ``solution`` cell (with a warning),
+        as ``make student --allow-without-solutions`` does.
+
+    Returns
+    -------
+    dict of str to bytes
+        Relative POSIX paths (without the top folder) in a fixed order.
+
+    Raises
+    ------
+    ValueError
+        If a needed file is missing, a notebook breaks the tag convention or has no
+        solution cell, or the Makefile lacks a rule the pack keeps.
+    """
+    root = Path(root)
+    for needed in ("Makefile", *TOP_FILES, "lqe_helpers/__init__.py", "tests"):
+        if not (root / needed).exists():
+            raise ValueError(f"root must be the course folder; {root / needed} is missing")
+    files: dict[str, bytes] = {}
+    names = []
+    for path in source_notebooks(root / "notebooks"):
+        notebook = read_notebook(path)
+        se.check_has_solutions(notebook, path.name,
+                               allow_without_solutions=allow_without_solutions)
+        files[f"notebooks/{path.name}"] = se.student_edition(notebook, path.stem).encode()
+        names.append(path.name)
+    for path in _files_under(root / "lqe_helpers"):
+        relative = path.relative_to(root / "lqe_helpers")
+        if relative.parts[0] not in INSTRUCTOR_PACKAGES:
+            files[f"lqe_helpers/{relative.as_posix()}"] = path.read_bytes()
+    left_out = []
+    for path in _files_under(root / "tests"):
+        relative = path.relative_to(root / "tests")
+        text = path.read_text("utf-8") if path.suffix == ".py" else None
+        if is_instructor_test(relative, text):
+            left_out.append(relative.parts[0])
+        else:
+            files[f"tests/{relative.as_posix()}"] = path.read_bytes()
+    files[f"tests/{STRUCTURE_TEST}"] = (PACK_FILES / STRUCTURE_TEST).read_bytes()
+    conventions = {
+        "tags": sorted(se.STUDENT_TAGS), "task_tag": se.TASK_TAG,
+        "task_prefix": se.TASK_PREFIX, "check_call": se.CHECK_CALL,
+        "going_further": se.GOING_FURTHER, "notebooks": names,
+        "checked_notebooks": [name for name in names if name.startswith(CHECKED_PREFIXES)],
+    }
+    files[f"tests/{CONVENTIONS_NAME}"] = (json.dumps(conventions, indent=1) + "\n").encode()
+    files["Makefile"] = pack_makefile((root / "Makefile").read_text("utf-8")).encode()
+    readme = (root / "README.md").read_text("utf-8")
+    title, _, rest = readme.partition("\n\n")
+    files["README.md"] = f"{title}\n\n{README_NOTE}{rest}".encode()
+    for name in TOP_FILES[1:]:
+        files[name] = (root / name).read_bytes()
+    files[MARKER_NAME] = marker_text(sorted(set(left_out))).encode()
+    return dict(sorted(files.items()))
+
+
+def marker_text(left_out_tests: Sequence[str]) -> str:
+    """The text of :data:`MARKER_NAME`."""
+    tests = ", ".join(f"`tests/{name}`" for name in left_out_tests) or "none"
+    return f"""# The LQE course pack: student pack
+
+This folder is the course pack for students. The notebooks in `notebooks/` are the
+student edition: every cell that starts with `# Task:` is yours to write, and every
+**Your answer** cell yours to fill in.
+
+```bash
+make lab     # first run: creates .venv, installs everything, opens JupyterLab on notebooks/
+make test    # the unit tests of lqe_helpers and the structure of the notebooks
+```
+
+`make test` here does not run the notebooks (your unfinished tasks would stop it by design);
+it checks that each notebook is valid, carries only the student edition's tags, has a check
+after every core task, and that its imports resolve. The checks inside the notebooks tell you
+whether your code is right: run a task, then the check cell below it.
+
+Left out of this pack, for the instructor: the worked notebooks, the marking guide, the
+authoring tools (`lqe_helpers/authoring/`) and their tests ({tests}).
+"""
+
+
+def zip_bytes(files: dict[str, bytes]) -> bytes:
+    """A zip of ``files`` under the top folder :data:`PACK_NAME`, the same bytes every time."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for name, data in files.items():
+            info = zipfile.ZipInfo(f"{PACK_NAME}/{name}", date_time=ZIP_TIME)
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = 0o644 << 16
+            archive.writestr(info, data)
+    return buffer.getvalue()
+
+
+def build_student_pack(root: Path, out_dir: Path, *,
+                       allow_without_solutions: bool = False) -> Path:
+    """Write :data:`ZIP_NAME` for the course folder ``root`` into ``out_dir``.
+
+    Parameters
+    ----------
+    root : Path
+        The course folder (only read).
+    out_dir : Path
+        Folder for the zip (created if needed). The tool replaces only what it wrote
+        there, atomically; it must not be, contain or lie inside ``root/notebooks``.
+    allow_without_solutions : bool
+        See :func:`pack_contents`.
+
+    Returns
+    -------
+    Path
+        The zip.
+
+    Raises
+    ------
+    ValueError
+        See :func:`pack_contents`; and :class:`~lqe_helpers.authoring.files.OutputFolderError`
+        if ``out_dir`` cannot be used.
+    """
+    root = Path(root)
+    data = zip_bytes(pack_contents(root, allow_without_solutions=allow_without_solutions))
+    [written] = write_output_folder(out_dir, {ZIP_NAME: data}, tool=TOOL_NAME,
+                                    source_dir=root / "notebooks")
+    return written
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Command line: build the student pack and print the zip's path."""
+    parser = CommandLineParser(prog="python -m lqe_helpers.authoring.student_pack",
+                               description=__doc__.splitlines()[0])
+    parser.add_argument("--root", type=Path, default=Path("."),
+                        help="the course folder (default: the current folder)")
+    parser.add_argument("--out", type=Path, default=Path("build/student-pack"),
+                        help="folder for lqe-student-pack.zip (default: build/student-pack)")
+    parser.add_argument("--allow-without-solutions", action="store_true",
+                        help="pack notebooks that have no 'solution' cell (with a warning) "
+                             "instead of refusing")
+
+    def command(args: argparse.Namespace) -> int:
+        print(build_student_pack(args.root, args.out,
+                                 allow_without_solutions=args.allow_without_solutions))
+        return 0
+
+    return run_command(parser, command, argv)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,164 @@
+"""Checks of notebooks 00 and 06: worked answers pass, typical mistakes fail with their own message.
+
+The wrong answers are written here as a student would write them, independently of the
+mistakes :mod:`lqe_helpers.checks` computes to recognise them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lqe_helpers import bias_model, checks
+from lqe_helpers.checks import CheckFailed
+
+
+def assert_passes(capsys: pytest.CaptureFixture[str], check, *args) -> str:
+    check(*args)
+    lines = capsys.readouterr().out.splitlines()
+    assert len(lines) == 1, lines
+    assert lines[0].startswith("✓ ")
+    return lines[0]
+
+
+def assert_fails(phrase: str, check, *args) -> str:
+    with pytest.raises(CheckFailed) as info:
+        check(*args)
+    assert phrase in str(info.value), str(info.value)
+    return str(info.value)
+
+
+# --- check_transition_matrix ----------------------------------------------------------------
+
+def make_A(dt, *, mistake=""):
+    corner = {"no half": dt**2, "no corner": 0.0, "half dt": dt / 2}.get(mistake, dt**2 / 2)
+    A = np.array([[1.0, dt, corner], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])
+    if mistake == "transposed":
+        return A.T
+    if mistake == "identity":
+        return np.eye(3)
+    return A
+
+
+def test_check_transition_matrix_passes_the_worked_solution(capsys):
+    line = assert_passes(capsys, checks.check_transition_matrix, make_A)
+    assert "make_A" in line and "eq. (4)" in line
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("transposed", "A is transposed"),
+    ("no half", "is Δt², but the Taylor term"),
+    ("no corner", "ignores the acceleration"),
+    ("half dt", "the corner entry is Δt/2"),
+    ("identity", "A is the identity"),
+])
+def test_check_transition_matrix_names_each_typical_mistake(mistake, phrase):
+    messages = assert_fails(phrase, checks.check_transition_matrix,
+                            lambda dt: make_A(dt, mistake=mistake))
+    assert "np." not in messages and "@" not in messages
+
+
+def test_check_transition_matrix_rejects_a_hard_coded_answer():
+    assert_fails("the same matrix for every time step", checks.check_transition_matrix,
+                 lambda dt: make_A(0.01))
+
+
+def test_check_transition_matrix_wants_a_3_by_3_matrix_and_the_function_written():
+    assert_fails("must be 3 × 3", checks.check_transition_matrix, lambda dt: np.eye(2))
+    assert_fails("returned nothing", checks.check_transition_matrix, lambda dt: None)
+
+    def not_written(dt):
+        raise NotImplementedError
+
+    assert_fails("is not written yet", checks.check_transition_matrix, not_written)
+
+
+# --- check_covariance_step -------------------------------------------------------------------
+
+def predict_covariance(P, F, G, sigma, *, mistake=""):
+    if mistake == "sides":
+        return F.T @ P @ F + sigma**2 * G @ G.T
+    if mistake == "no noise":
+        return F @ P @ F.T
+    if mistake == "sigma":
+        return F @ P @ F.T + sigma * G @ G.T
+    if mistake == "no transpose":
+        return F @ P @ F + sigma**2 * G @ G.T
+    if mistake == "not moved":
+        return P + sigma**2 * G @ G.T
+    return F @ P @ F.T + sigma**2 * G @ G.T
+
+
+def test_check_covariance_step_passes_the_worked_solution(capsys):
+    line = assert_passes(capsys, checks.check_covariance_step, predict_covariance)
+    assert "F P Fᵀ + G σ² Gᵀ" in line
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("sides", "on the wrong sides"),
+    ("no noise", "is not added"),
+    ("sigma", "σ is used where its square belongs"),
+    ("no transpose", "the second F is not transposed"),
+    ("not moved", "P is not carried through the model"),
+])
+def test_check_covariance_step_names_each_typical_mistake(mistake, phrase):
+    assert_fails(phrase, checks.check_covariance_step,
+                 lambda P, F, G, s: predict_covariance(P, F, G, s, mistake=mistake))
+
+
+def test_check_covariance_step_rejects_changing_p_in_place_and_wrong_shapes():
+    def in_place(P, F, G, sigma):
+        P += sigma**2 * G @ G.T
+        return P
+
+    assert_fails("changed its input P in place", checks.check_covariance_step, in_place)
+    assert_fails("the new covariance has the shape of P", checks.check_covariance_step,
+                 lambda P, F, G, s: s**2 * G.T @ G)
+
+
+def test_check_covariance_step_agrees_with_the_pack_on_the_butterfly(capsys):
+    from lqe_helpers import model, prediction
+
+    dt, sigma_j = 0.01, 1400.0
+    A, g = model.transition_matrix(dt), model.jerk_input_matrix(dt)
+    P = np.diag([1.0, 4.0, 9.0])
+    expected = prediction.propagate_covariance(P, A, model.process_noise_covariance(
+        dt, sigma_j), 1)[1]
+    np.testing.assert_allclose(predict_covariance(P, A, g, sigma_j), expected, rtol=1e-12)
+
+
+# --- check_bias_model ------------------------------------------------------------------------
+
+DT, SIGMA_A = 0.01, 20.0
+
+
+def bias_matrices(*, mistake=""):
+    F = bias_model.transition_matrix(DT).copy()
+    G = bias_model.input_matrix(DT).copy()
+    sigma = SIGMA_A if mistake != "sigma" else np.sqrt(SIGMA_A)
+    if mistake == "bias added":
+        F[:2, 2] *= -1
+    if mistake == "G no half":
+        G[0, 0] = DT**2
+    if mistake == "G flat":
+        G = G[:, 0]
+        return F, G, sigma**2 * np.outer(G, G)
+    Q = sigma**2 * G @ G.T
+    if mistake == "Q identity":
+        Q = SIGMA_A**2 * np.eye(3)
+    return F, G, Q
+
+
+def test_check_bias_model_passes_the_worked_solution(capsys):
+    assert_passes(capsys, checks.check_bias_model, *bias_matrices(), DT, SIGMA_A)
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("bias added", "adds the bias"),
+    ("G no half", "G[0] holds Δt²"),
+    ("G flat", "make it a column"),
+    ("sigma", "uses σ_a where its square belongs"),
+    ("Q identity", "is not pushed through G"),
+])
+def test_check_bias_model_names_each_typical_mistake(mistake, phrase):
+    assert_fails(phrase, checks.check_bias_model, *bias_matrices(mistake=mistake), DT, SIGMA_A)

@@ -1,0 +1,282 @@
+"""Tests of lqe_helpers.figures: each function draws the data it is given."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+from lqe_helpers import figures
+
+# --- tracking_comparison_figure, paired_mse_figure, start_up_figure, squared_error_figure ---
+
+def test_tracking_comparison_figure_draws_estimates_and_their_errors():
+    times = np.linspace(0.0, 1.0, 11)
+    truth = np.sin(times)
+    estimate = truth + 0.1 * np.cos(7 * times)
+    readings = truth + 0.5
+    fig = figures.tracking_comparison_figure(
+        times, truth, {"fused": (estimate, "estimate")},
+        readings={"vision": (readings, "vision")}, title="σ_v = 1.5 cm")
+    try:
+        assert isinstance(fig, Figure)
+        top, bottom = fig.axes
+        lines = top.get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), readings)
+        np.testing.assert_array_equal(lines[1].get_ydata(), truth)
+        np.testing.assert_array_equal(lines[2].get_ydata(), estimate)
+        error = next(line for line in bottom.get_lines() if line.get_label() == "fused")
+        np.testing.assert_allclose(error.get_ydata(), estimate - truth)
+        assert top.get_title() == "σ_v = 1.5 cm"
+    finally:
+        plt.close(fig)
+
+
+def test_paired_mse_figure_puts_one_point_per_run():
+    first = np.array([1.0, 2.0, 3.0])
+    second = np.array([0.5, 1.5, 3.5])
+    fig = figures.paired_mse_figure(first, second, "vision only", "fused")
+    try:
+        runs = fig.axes[0].get_lines()[0]
+        np.testing.assert_array_equal(runs.get_xdata(), first)
+        np.testing.assert_array_equal(runs.get_ydata(), second)
+        assert "vision only" in fig.axes[0].get_xlabel()
+    finally:
+        plt.close(fig)
+
+
+def test_paired_mse_figure_rejects_unpaired_runs():
+    with pytest.raises(ValueError, match="paired"):
+        figures.paired_mse_figure(np.ones(3), np.ones(4), "a", "b")
+
+
+def test_start_up_figure_shows_position_and_velocity_up_to_until():
+    times = np.arange(0.0, 3.0, 0.5)
+    truth = np.stack([times, 2 * times], axis=1)
+    estimate = truth + 1.0
+    fig = figures.start_up_figure(times, truth, {"P0 = diag(1)": (estimate, "estimate")},
+                                  until=1.0)
+    try:
+        ax_p, ax_v = fig.axes
+        shown = times <= 1.0
+        np.testing.assert_array_equal(ax_p.get_lines()[1].get_ydata(), estimate[shown, 0])
+        np.testing.assert_array_equal(ax_v.get_lines()[1].get_ydata(), estimate[shown, 1])
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="until"):
+        figures.start_up_figure(times, truth, {}, until=0.0)
+
+
+def test_squared_error_figure_draws_curves_on_a_log_axis():
+    times = np.linspace(0.0, 2.0, 21)
+    curve = np.exp(-times) + 0.1
+    fig = figures.squared_error_figure(times, {"diag(1)": (curve, "estimate")},
+                                       threshold=0.2, marks={"t": (0.5, "estimate")})
+    try:
+        ax = fig.axes[0]
+        assert ax.get_yscale() == "log"
+        np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), curve)
+        assert any(np.allclose(line.get_ydata(), 0.2) for line in ax.get_lines()[1:])
+    finally:
+        plt.close(fig)
+
+
+# --- estimate_error_figure, delay_figure (notebooks 01 and 05) ---
+
+def test_estimate_error_figure_draws_each_error_and_its_band():
+    times = np.linspace(0.0, 2.0, 21)
+    error = 0.3 * np.sin(3 * times)
+    systematic = 0.1 * np.cos(times)
+    std = np.full_like(times, 0.5)
+    fig = figures.estimate_error_figure(
+        times, {"σ_v = 1.5 cm": (error, std, systematic, "estimate"),
+                "σ_v = 4.5 cm": (2 * error, 2 * std, 2 * systematic, "alternative")},
+        skipped=0.5)
+    try:
+        assert isinstance(fig, Figure)
+        first, second = fig.axes
+        np.testing.assert_array_equal(first.get_lines()[0].get_ydata(), error)
+        np.testing.assert_array_equal(first.get_lines()[1].get_ydata(), systematic)
+        np.testing.assert_array_equal(second.get_lines()[0].get_ydata(), 2 * error)
+        band = first.collections[0].get_paths()[0].vertices[:, 1]
+        assert band.max() == pytest.approx(1.0) and band.min() == pytest.approx(-1.0)
+        assert first.get_title(loc="left") == "σ_v = 1.5 cm"
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="panels"):
+        figures.estimate_error_figure(times, {})
+
+
+def test_delay_figure_draws_the_four_series_and_shades_the_start():
+    times = np.arange(0.0, 1.0, 0.01)
+    truth = np.sin(2 * np.pi * times)
+    late = np.concatenate([np.full(10, np.nan), truth[:-10]])
+    fig = figures.delay_figure(times, truth, late + 0.2, late, truth + 0.05, delay=0.1,
+                               fast_window=(0.4, 0.6))
+    try:
+        ax_all, ax_start, ax_fast = fig.axes
+        lines = ax_all.get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), late + 0.2)
+        np.testing.assert_array_equal(lines[1].get_ydata(), truth)
+        np.testing.assert_array_equal(lines[2].get_ydata(), late)
+        np.testing.assert_array_equal(lines[3].get_ydata(), truth + 0.05)
+        assert ax_start.get_xlim() == pytest.approx((0.0, 0.5))
+        assert ax_fast.get_xlim() == pytest.approx((0.4, 0.6))
+        shaded = ax_start.patches[0].get_extents().transformed(ax_start.transData.inverted())
+        assert shaded.x0 == pytest.approx(0.0) and shaded.x1 == pytest.approx(0.1)
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="delay"):
+        figures.delay_figure(times, truth, late, late, truth, delay=0.0)
+
+
+# --- notebooks 00 and 06: open_loop_figure, mse_intervals_figure, uncertainty_growth_figure,
+# --- jerk_sweep_figure, tracking_panels_figure, bias_learning_figure,
+# --- acceleration_signal_figure, drift_figure, noise_sweep_figure, bias_settling_figure
+
+def _intervals(means, half=0.1):
+    from lqe_helpers.metrics import Interval
+
+    return [Interval(mean=m, low=m - half, high=m + half, runs=10) for m in means]
+
+
+def test_open_loop_figure_draws_tracking_then_the_prediction_and_its_band():
+    times = np.arange(0.0, 3.0, 0.5)
+    truth, readings, estimate = np.sin(times), np.sin(times) + 0.3, np.sin(times) + 0.1
+    pred_times = np.array([2.0, 2.5])
+    pred, std = np.array([1.0, 2.0]), np.array([0.5, 1.0])
+    fig = figures.open_loop_figure(times, truth, readings, estimate, 2.0, pred_times, pred, std,
+                                   start=0.0)
+    try:
+        lines = fig.axes[0].get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), readings[times <= 2.0])
+        np.testing.assert_array_equal(lines[2].get_ydata(), estimate[times <= 2.0])
+        np.testing.assert_array_equal(lines[3].get_ydata(), pred)
+        band = fig.axes[0].collections[0].get_paths()[0].vertices[:, 1]
+        assert band.max() == pytest.approx(4.0) and band.min() == pytest.approx(0.0)
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="limit"):
+        figures.open_loop_figure(times, truth, readings, estimate, 2.0, pred_times, pred, std,
+                                 limit=0.0)
+
+
+def test_mse_intervals_figure_puts_one_row_per_interval():
+    fig = figures.mse_intervals_figure(["a", "b"], _intervals([1.0, 2.0]), reference=1.5)
+    try:
+        np.testing.assert_array_equal(fig.axes[0].get_lines()[0].get_xdata(), [1.0, 2.0])
+        assert [t.get_text() for t in fig.axes[0].get_yticklabels()] == ["a", "b"]
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="labels"):
+        figures.mse_intervals_figure(["a"], _intervals([1.0, 2.0]))
+
+
+def test_uncertainty_growth_figure_draws_each_curve_on_log_axes():
+    elapsed = np.array([0.1, 0.5, 1.0])
+    fig = figures.uncertainty_growth_figure(elapsed, {"P = 0": (elapsed**2.5, "-", 2.0)},
+                                            amplitude=10.0)
+    try:
+        ax = fig.axes[0]
+        assert ax.get_xscale() == "log" and ax.get_yscale() == "log"
+        np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), elapsed**2.5)
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="elapsed"):
+        figures.uncertainty_growth_figure(np.array([0.0, 1.0]), {})
+
+
+def test_jerk_sweep_figure_draws_the_mse_and_its_parts():
+    jerks = np.array([10.0, 100.0, 1000.0])
+    fig = figures.jerk_sweep_figure(jerks, _intervals([3.0, 1.0, 2.0]), [2.9, 0.5, 0.1],
+                                    [0.1, 0.5, 1.9], [0.01, 0.9, 2.5], 2.25, 100.0)
+    try:
+        lines = fig.axes[0].get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), [3.0, 1.0, 2.0])
+        data = [np.asarray(line.get_ydata()).tolist() for line in lines]
+        assert [2.9, 0.5, 0.1] in data and [0.01, 0.9, 2.5] in data
+    finally:
+        plt.close(fig)
+
+
+def test_tracking_panels_figure_draws_one_panel_per_filter():
+    times = np.linspace(0.0, 5.0, 51)
+    truth = np.sin(times)
+    fig = figures.tracking_panels_figure(times, truth, truth + 0.5,
+                                         {"slow": truth * 0.5, "fast": truth * 2}, (2.0, 4.0))
+    try:
+        shown = (times >= 2.0) & (times <= 4.0)
+        assert len(fig.axes) == 2
+        np.testing.assert_array_equal(fig.axes[1].get_lines()[2].get_ydata(), 2 * truth[shown])
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="window"):
+        figures.tracking_panels_figure(times, truth, truth, {"a": truth}, (4.0, 2.0))
+
+
+def test_bias_learning_figure_draws_the_run_and_the_monte_carlo_error():
+    times = np.linspace(0.0, 4.0, 41)
+    estimate = 20 * (1 - np.exp(-times))
+    fig = figures.bias_learning_figure(times, estimate, np.full_like(times, 2.0), 20.0,
+                                       np.exp(-times) + 0.1, np.exp(-times) + 0.2, until=3.0)
+    try:
+        ax_run, ax_mc = fig.axes
+        np.testing.assert_array_equal(ax_run.get_lines()[1].get_ydata(), estimate[times <= 3.0])
+        np.testing.assert_array_equal(ax_mc.get_lines()[0].get_ydata(), np.exp(-times) + 0.1)
+        assert ax_mc.get_yscale() == "log"
+    finally:
+        plt.close(fig)
+
+
+def test_acceleration_signal_figure_draws_readings_truth_and_shifted_truth():
+    times = np.linspace(0.0, 3.0, 31)
+    accel = np.cos(times)
+    fig = figures.acceleration_signal_figure(times, accel + 5.0, accel, bias=4.0)
+    try:
+        lines = fig.axes[0].get_lines()
+        shown = times <= 2.0
+        np.testing.assert_array_equal(lines[0].get_ydata(), accel[shown] + 5.0)
+        np.testing.assert_allclose(lines[2].get_ydata(), accel[shown] + 4.0)
+    finally:
+        plt.close(fig)
+
+
+def test_drift_figure_draws_theory_then_errors():
+    elapsed = np.array([0.1, 1.0, 10.0])
+    fig = figures.drift_figure(elapsed, {"dead reckoning": (elapsed**2, "alternative", "-")},
+                               {"b t²/2": (elapsed**2 / 2, "-")}, amplitude=10.0)
+    try:
+        lines = fig.axes[0].get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), elapsed**2 / 2)
+        np.testing.assert_array_equal(lines[1].get_ydata(), elapsed**2)
+    finally:
+        plt.close(fig)
+
+
+def test_noise_sweep_figure_draws_mse_and_bias_errors():
+    values = np.array([1.0, 10.0, 100.0])
+    fig = figures.noise_sweep_figure(values, _intervals([0.1, 0.2, 0.9]), _intervals([0.4])[0],
+                                     [0.1, 1.0, 10.0], [0.12, 1.1, 9.0], 10.0, "σ_a (cm/s²)")
+    try:
+        ax_mse, ax_bias = fig.axes
+        np.testing.assert_array_equal(ax_mse.get_lines()[0].get_ydata(), [0.1, 0.2, 0.9])
+        np.testing.assert_array_equal(ax_bias.get_lines()[0].get_ydata(), [0.1, 1.0, 10.0])
+    finally:
+        plt.close(fig)
+
+
+def test_bias_settling_figure_draws_mean_errors_and_filter_stds():
+    times = np.linspace(0.0, 4.0, 41)
+    fig = figures.bias_settling_figure(times, {"b = 20": -20 * np.exp(-times)},
+                                       {"σ_v = 1.5": np.exp(-times) + 0.1})
+    try:
+        ax_b, ax_v = fig.axes
+        early = times <= 2.0
+        np.testing.assert_array_equal(ax_b.get_lines()[0].get_ydata(),
+                                      -20 * np.exp(-times[early]))
+        np.testing.assert_array_equal(ax_v.get_lines()[0].get_ydata(), np.exp(-times) + 0.1)
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="until"):
+        figures.bias_settling_figure(times, {}, {}, until=0.0)

@@ -1,0 +1,325 @@
+"""The student edition does not give the answers away.
+
+For every notebook in ``notebooks/`` (the worked, executed notebooks) the student
+edition is built (``student_edition.student_edition``) and searched for two kinds of
+leak. "The student edition" is everything in the student notebook: the source of every
+cell (markdown and code, the kept ``# Task:`` comments and check cells included) and any
+output (the build clears them, so there should be none).
+
+1. **A sentence of a worked answer.** The body of every cell tagged ``answer`` (its text
+   below the headings the edition keeps on purpose) is cut into sentences: at blank
+   lines, at list items and after ``.``, ``!`` or ``?`` followed by a space (not after
+   an abbreviation such as "eq." or "e.g."). Markdown
+   emphasis (``*``, `````), list bullets, case and runs of white space are ignored. A
+   sentence of at least :data:`MIN_SENTENCE_WORDS` words that does not end in ``?`` (a
+   question is not a conclusion) leaks if it appears anywhere in the student edition
+   normalised the same way: for example a Summary or "What you will learn" cell that
+   repeats the answer's conclusion.
+
+2. **A result printed by a solution cell.** Every number in the saved text outputs of
+   every cell tagged ``solution`` (printed text, and the plain-text, Markdown or HTML
+   form of displayed results such as tables and figure descriptions; images are not
+   text) is a *result* if it has at least three significant digits
+   (:func:`significant_digits`: leading zeros never count, trailing zeros of a whole
+   number without a decimal point do not count, so ``1000`` and ``0.05`` have one,
+   ``1.26``, ``0.0421``, ``12.0`` and ``1974`` three or four) and its value is neither
+   among the numbers of the question's text nor typed as a number literal in the code
+   of a solution cell (such a number is an input the author chose, like an assumed
+   σ̃_p = 13.5 cm, not a result the code computed; a literal in an untagged cell is
+   not excused, since it stays in the student edition). **The question's text** is the
+   tutorial question as the notebook quotes it: every markdown cell whose first line
+   is a heading starting "The question" (``## The question (a) — 15 marks``). A result
+   leaks if a number of the same value (``1.260`` is ``1.26``; the sign and thousands
+   separators are ignored) with at least three significant digits appears anywhere in
+   the student edition: a number typed into prose, an untagged cell's code, or a task
+   comment.
+
+Only the notebooks' saved outputs are read, so a notebook must have been executed
+(``make notebooks``); one that was not fails here rather than pass for want of outputs.
+The first tests run the detectors on small notebooks written to show that each can fail.
+"""
+
+from __future__ import annotations
+
+import html
+import io
+import re
+import tokenize
+from decimal import Decimal
+from pathlib import Path
+
+import nbformat
+import pytest
+from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
+
+from lqe_helpers.authoring import student_edition as se
+
+NOTEBOOK_DIR = Path(__file__).resolve().parents[1] / "notebooks"
+NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("*.ipynb"))
+
+#: A shorter "sentence" ("Yes.", "See Figure 2.") is not checked.
+MIN_SENTENCE_WORDS = 5
+#: Results need at least this many significant digits.
+MIN_SIGNIFICANT_DIGITS = 3
+#: First line of a markdown cell quoting the tutorial's question.
+QUESTION_HEADING = re.compile(r"#{1,6}\s*the question\b", re.IGNORECASE)
+#: A number: optional sign, digits with optional thousands separators, decimals, exponent.
+NUMBER = re.compile(
+    r"(?<![\w.])[-−+]?(?:\d{1,3}(?:,\d{3})+|\d+)(?:\.\d+)?(?:[eE][-+−]?\d+)?(?![\w])"
+    r"|(?<![\w.])[-−+]?\.\d+(?![\w])")
+#: A sentence does not end after these.
+ABBREVIATION = re.compile(r"(?:^|\s|\()(?:eqs?|e\.g|i\.e|cf|figs?|vs|approx|etc|no)\.$")
+#: Where the kept text of a displayed result lives, best first.
+TEXT_MIMETYPES = ("text/markdown", "text/html", "text/plain")
+
+
+def tags(cell: nbformat.NotebookNode) -> list[str]:
+    return list(cell.get("metadata", {}).get("tags", []))
+
+
+# ------------------------------------------------------------------------ numbers
+
+
+def significant_digits(token: str) -> int:
+    """Significant digits of a number as written (see the module docstring)."""
+    mantissa = re.split(r"[eE]", token.replace(",", "").lstrip("-−+"))[0]
+    if "." in mantissa:
+        return len(mantissa.replace(".", "").lstrip("0"))
+    return len(mantissa.lstrip("0").rstrip("0"))
+
+
+def number_value(token: str) -> Decimal:
+    """The value of a number as written, without its sign (``1.260`` → ``1.26``)."""
+    return Decimal(token.replace(",", "").replace("−", "-").lstrip("-+")).normalize()
+
+
+def numbers(text: str) -> list[str]:
+    return NUMBER.findall(text)
+
+
+def results(text: str) -> set[Decimal]:
+    """Values of the numbers in ``text`` with at least three significant digits."""
+    return {number_value(token) for token in numbers(text)
+            if significant_digits(token) >= MIN_SIGNIFICANT_DIGITS}
+
+
+def output_text(output: nbformat.NotebookNode) -> str:
+    """The text an output shows: printed text, or a displayed result's best text form."""
+    if output.output_type == "stream":
+        return output.text
+    if output.output_type == "error":
+        return f"{output.ename}: {output.evalue}"
+    data = output.get("data", {})
+    for mimetype in TEXT_MIMETYPES:
+        if mimetype in data:
+            text = data[mimetype]
+            text = "".join(text) if isinstance(text, list) else text
+            if mimetype == "text/html":
+                text = html.unescape(re.sub(r"<[^>]*>", " ", text))
+            return text
+    return ""
+
+
+def question_text(notebook: nbformat.NotebookNode) -> str:
+    """The tutorial question as the notebook quotes it (see the module docstring)."""
+    return "\n".join(cell.source for cell in notebook.cells
+                     if cell.cell_type == "markdown"
+                     and QUESTION_HEADING.match(cell.source.lstrip()))
+
+
+def code_literals(notebook: nbformat.NotebookNode) -> set[Decimal]:
+    """Values of the number literals typed in solution cells' code (inputs, not results)."""
+    found = set()
+    for cell in notebook.cells:
+        if se.SOLUTION_TAG not in tags(cell):
+            continue
+        try:
+            tokens = list(tokenize.generate_tokens(io.StringIO(cell.source + "\n").readline))
+        except (tokenize.TokenError, SyntaxError):  # IPython syntax: no literals taken
+            continue
+        found |= {number_value(token.string.replace("_", "")) for token in tokens
+                  if token.type == tokenize.NUMBER and NUMBER.fullmatch(token.string)}
+    return found
+
+
+def printed_results(notebook: nbformat.NotebookNode) -> dict[Decimal, str]:
+    """Results printed by solution cells (see the module docstring): value → where printed."""
+    allowed = {number_value(token) for token in numbers(question_text(notebook))}
+    allowed |= code_literals(notebook)
+    found: dict[Decimal, str] = {}
+    for index, cell in enumerate(notebook.cells):
+        if se.SOLUTION_TAG not in tags(cell):
+            continue
+        for output in cell.get("outputs", []):
+            for value in results(output_text(output)) - allowed:
+                found.setdefault(value, se.cell_place("source", index, cell))
+    return found
+
+
+# ---------------------------------------------------------------------- sentences
+
+
+def normalise(text: str) -> str:
+    """Lower case, without markdown emphasis, list bullets or runs of white space."""
+    text = re.sub(r"(?m)^\s*(?:[-*+]|\d+\.)\s+", " ", text)
+    text = re.sub(r"[*`]", "", text)
+    return " ".join(text.lower().split())
+
+
+def sentences(markdown: str) -> list[str]:
+    """The sentences of a markdown text, normalised (see the module docstring)."""
+    pieces = re.split(r"\n\s*\n|\n(?=\s*(?:[-*+]|\d+\.)\s)", markdown)
+    found = []
+    for piece in pieces:
+        joined: list[str] = []
+        for part in re.split(r"(?<=[.!?])\s+", normalise(piece)):
+            if joined and ABBREVIATION.search(joined[-1]):
+                joined[-1] += " " + part
+            else:
+                joined.append(part)
+        found += [sentence for sentence in joined
+                  if len(sentence.split()) >= MIN_SENTENCE_WORDS and not sentence.endswith("?")]
+    return found
+
+
+def answer_sentences(notebook: nbformat.NotebookNode) -> dict[str, str]:
+    """Sentences of the worked answers: sentence → the answer cell it comes from."""
+    found: dict[str, str] = {}
+    for index, cell in enumerate(notebook.cells):
+        if se.ANSWER_TAG in tags(cell):
+            headings = se.answer_headings(cell.source)
+            body = "\n".join(line for line in cell.source.splitlines()
+                             if line.rstrip() not in headings)
+            for sentence in sentences(body):
+                found.setdefault(sentence, se.cell_place("source", index, cell))
+    return found
+
+
+# -------------------------------------------------------------------------- leaks
+
+
+def student_cells(student: nbformat.NotebookNode) -> list[tuple[str, str]]:
+    """(place, text) of every cell of the student edition: its source and its outputs."""
+    return [(se.cell_place("student", index, cell),
+             "\n".join([cell.source, *(output_text(o) for o in cell.get("outputs", []))]))
+            for index, cell in enumerate(student.cells)]
+
+
+def find_leaks(source: nbformat.NotebookNode, student: nbformat.NotebookNode) -> list[str]:
+    """Every answer sentence and printed result of ``source`` found in ``student``."""
+    leaks = []
+    sentences_of = answer_sentences(source)
+    printed = printed_results(source)
+    for place, text in student_cells(student):
+        flat = normalise(text)
+        for sentence, origin in sentences_of.items():
+            if sentence in flat:
+                leaks.append(f"{place} repeats a sentence of the answer in {origin}: "
+                             f"{sentence!r}")
+        for value in sorted(results(text) & set(printed)):
+            leaks.append(f"{place} contains {value}, printed by {printed[value]}")
+    return leaks
+
+
+def student_of(notebook: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
+    return nbformat.reads(se.student_edition(notebook, name), as_version=4)
+
+
+# --------------------------------------------------------- the detectors can fail
+
+SOLUTION = ("# Task: compute the MSE of the filter at σ_v = 1.5 cm over 1000 samples.\n"
+            "mse = 1.2594\nprint(f'MSE = {mse:.3f} cm², ratio 6.21, n = 1000, x = 0.05')")
+ANSWER = ("#### Answer to (a): does filtering help?\n\n"
+          "- *Yes:* the filtered estimate is **six times** closer to the truth than vision.\n"
+          "- Does it always help? Short.\n\nThe band holds 95 % of the path. Good.")
+QUESTION = "## The question (a) — 15 marks\n\nAt σ_v = 1.5 cm, is the MSE below 6.21 cm²?"
+
+
+def leak_fixture(*extra: nbformat.NotebookNode) -> nbformat.NotebookNode:
+    solution = new_code_cell(SOLUTION, metadata={"tags": ["solution"]}, execution_count=1,
+                             outputs=[new_output("stream", name="stdout",
+                                                 text="MSE = 1.259 cm², ratio 6.21, "
+                                                      "n = 1000, x = 0.05\n")])
+    return new_notebook(cells=[
+        new_markdown_cell("# Fixture\n\nHow well does the filter do?"),
+        new_markdown_cell(QUESTION), solution,
+        new_markdown_cell(ANSWER, metadata={"tags": ["answer"]}), *extra])
+
+
+@pytest.mark.parametrize(("token", "digits"), [
+    ("1000", 1), ("0.05", 1), ("1.26", 3), ("0.0421", 3), ("12.0", 3), ("1974", 4),
+    ("1,974", 4), ("0.100", 3), ("-3.13", 3), ("1.5e+05", 2), ("2.04e-3", 3), ("0", 0),
+    ("100.", 3), (".125", 3)])
+def test_significant_digits(token, digits):
+    assert significant_digits(token) == digits
+
+
+def test_numbers_are_found_as_written_and_compared_by_value():
+    assert numbers("P0 = diag(1e5), x1 = 3, K = [0.177, 1.73] at 1,396 cm/s³; v1.2.3") == [
+        "1e5", "3", "0.177", "1.73", "1,396"]
+    assert results("1.260 and −1.26 and 1,396.0 and 1.5") == {Decimal("1.26"),
+                                                             Decimal("1396")}
+
+
+def test_sentences_ignore_markdown_questions_and_short_ones():
+    assert sentences(ANSWER.split("\n\n", 1)[1]) == [
+        "yes: the filtered estimate is six times closer to the truth than vision.",
+        "the band holds 95 % of the path."]
+
+
+def test_a_clean_student_edition_has_no_leak():
+    notebook = leak_fixture(new_markdown_cell("## Summary\n\nDoes filtering help, and why?"))
+    assert printed_results(notebook) == {Decimal("1.259"): se.cell_place("source", 2,
+                                                                         notebook.cells[2])}
+    assert find_leaks(notebook, student_of(notebook, "clean")) == []
+
+
+@pytest.mark.parametrize(("cell", "expected"), [
+    (new_markdown_cell("## Summary\n\n* Yes: the filtered estimate is six times closer to\n"
+                       "  the truth than **vision**."), "repeats a sentence of the answer"),
+    (new_markdown_cell("What you will learn: the MSE comes out at 1.2590 cm²."),
+     "contains 1.259, printed by source, cell 2"),
+    (new_code_cell("expected = 1.259  # untagged code gives it away too"), "contains 1.259"),
+])
+def test_a_leak_is_found_and_placed(cell, expected):
+    notebook = leak_fixture(cell)
+    leaks = find_leaks(notebook, student_of(notebook, "leaky"))
+    assert len(leaks) == 1
+    assert leaks[0].startswith("student, cell 5 (")
+    assert expected in leaks[0]
+
+
+def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
+    notebook = leak_fixture(new_code_cell(
+        "# Task: check that your MSE is 1.259 cm² and below 6.21 cm².\nx = 1",
+        metadata={"tags": ["solution"]}))
+    leaks = find_leaks(notebook, student_of(notebook, "task"))
+    assert leaks == [f"{se.cell_place('student', 5, notebook.cells[4])} contains 1.259, "
+                     f"printed by {se.cell_place('source', 2, notebook.cells[2])}"]
+
+
+# ------------------------------------------------------------- the pack's notebooks
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_the_student_edition_gives_no_answer_away(path):
+    source = nbformat.read(path, as_version=4)
+    assert any(cell.get("execution_count") for cell in source.cells
+               if cell.cell_type == "code"), (
+        f"{path.name} has not been executed: its printed results are unknown "
+        f"(run `make notebooks`)")
+    leaks = find_leaks(source, student_of(source, path.stem))
+    assert not leaks, f"{len(leaks)} leak(s) in the student edition:\n" + "\n".join(leaks)
+
+
+def test_abbreviations_do_not_end_a_sentence():
+    assert sentences("The last line of eq. (5) updates P, e.g. after the gain. Then it ends.") == [
+        "the last line of eq. (5) updates p, e.g. after the gain."]
+
+
+def test_a_number_typed_in_code_is_an_input_not_a_result():
+    notebook = leak_fixture(new_markdown_cell("Assume σ̃_p = 13.5 cm and 1.259 cm²."))
+    notebook.cells[2].source += "\nassumed = 13.5"
+    notebook.cells[2].outputs[0].text += "assumed 13.5 cm\n"
+    leaks = find_leaks(notebook, student_of(notebook, "inputs"))
+    assert [leak.split(" contains ")[1].split(",")[0] for leak in leaks] == ["1.259"]
