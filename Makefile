@@ -23,7 +23,7 @@ CHECK_VENV = if [ -e $(VENV) ] || [ -L $(VENV) ]; then reason=""; \
 	if [ -n "$$reason" ]; then \
 	  echo "error: .venv is broken ($$reason); run make clean, then make lab" >&2; exit 1; fi; fi
 
-.PHONY: lab test lint notebooks handouts student student-pack bench clean
+.PHONY: lab test lint notebooks handouts student student-pack bench bench-browser clean
 
 $(BIN)/python:
 	@$(CHECK_VENV)
@@ -82,6 +82,10 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_filter.py
 	$(BIN)/python benchmarks/bench_widgets.py
 	$(BIN)/python benchmarks/bench_notebooks.py
+
+# Key press on a slider -> new picture shown, in a real JupyterLab (needs Debian's chromium).
+bench-browser: $(STAMP)
+	$(BIN)/python benchmarks/bench_browser.py
 
 # Removes only what the Makefile made. In each tool's folder under build/, only the files
 # listed in its .lqe-manifest.json and unchanged since (anything else there is kept and

@@ -137,6 +137,10 @@ _CSS = r"""
   --jp-mirror-editor-hr-color: #6b6b6b;
 }
 .jp-RenderedHTMLCommon a, nav.lqe-nav a { color: var(--jp-content-link-color); }
+/* Links in running text are underlined, so colour is never the only cue (WCAG 1.4.1). */
+.jp-RenderedHTMLCommon a, .jp-RenderedHTMLCommon a:link, .jp-RenderedHTMLCommon a:visited {
+  text-decoration: underline;
+}
 a:focus-visible {
   outline: 3px solid #0b57d0; outline-offset: 2px; border-radius: 2px;
 }
