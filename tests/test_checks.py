@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from check_outcomes import assert_fails, assert_passes
 
 from lqe_helpers import checks, metrics, model, reference, scenario, simulation
 from lqe_helpers.checks import CheckFailed
@@ -17,22 +18,6 @@ from lqe_helpers.checks import CheckFailed
 # ------------------------------------------------------------------------------------------
 
 
-def assert_passes(capsys: pytest.CaptureFixture[str], check, *args) -> str:
-    """Run a check that must pass; return its single output line."""
-    check(*args)
-    lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 1, lines
-    assert lines[0].startswith("✓ ")
-    return lines[0]
-
-
-def assert_fails(phrase: str, check, *args) -> str:
-    """Run a check that must fail with ``phrase`` in its message; return the message."""
-    with pytest.raises(CheckFailed) as info:
-        check(*args)
-    message = str(info.value)
-    assert phrase in message, message
-    return message
 
 
 def test_check_failed_is_an_assertion_error() -> None:

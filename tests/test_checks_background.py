@@ -8,25 +8,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from check_outcomes import assert_fails, assert_passes
 
 from lqe_helpers import bias_model, checks
-from lqe_helpers.checks import CheckFailed
-
-
-def assert_passes(capsys: pytest.CaptureFixture[str], check, *args) -> str:
-    check(*args)
-    lines = capsys.readouterr().out.splitlines()
-    assert len(lines) == 1, lines
-    assert lines[0].startswith("✓ ")
-    return lines[0]
-
-
-def assert_fails(phrase: str, check, *args) -> str:
-    with pytest.raises(CheckFailed) as info:
-        check(*args)
-    assert phrase in str(info.value), str(info.value)
-    return str(info.value)
-
 
 # --- check_transition_matrix ----------------------------------------------------------------
 
