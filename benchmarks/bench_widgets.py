@@ -1,6 +1,8 @@
 """How long a slider move takes: value set → new picture ready to send, for every explorer.
 
-Run: ``.venv/bin/python benchmarks/bench_widgets.py`` (or ``make bench``).
+Run: ``.venv/bin/python benchmarks/bench_widgets.py`` (or ``make bench``); with
+``--encoders``, it also compares the pack's PNG writer with Pillow's on every
+explorer's picture.
 
 For each explorer and each of its sliders, the slider is moved back and forth between
 two valid values and the time from setting ``.value`` to the PNG bytes being ready is
@@ -14,6 +16,7 @@ quiet 2-core machine. The worst ratio is printed last.
 
 from __future__ import annotations
 
+import argparse
 import importlib
 import io
 import statistics
@@ -22,6 +25,9 @@ import time
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from PIL import Image
+
+from lqe_helpers import png
 
 #: (notebook, module, factory) of every explorer in the pack.
 EXPLORERS = [
@@ -86,7 +92,42 @@ def time_slider_moves(explorer, name: str) -> tuple[list[float], list[float]]:
     return moves, peers
 
 
+def compare_encoders() -> None:
+    """Median time (ms) of Pillow's PNG encoder and of the pack's on each default picture."""
+    print("\nPNG encoding of each explorer's picture (RGB), median of 10: Pillow at "
+          f"compress_level={png.COMPRESS_LEVEL} (adaptive row filters) against "
+          "lqe_helpers.png.encode (no row filters)")
+    for notebook, module_name, factory in EXPLORERS:
+        explorer = getattr(importlib.import_module(module_name), factory)()
+        rgb = np.ascontiguousarray(np.asarray(explorer.layers.render())[..., :3])
+        image = Image.fromarray(rgb)
+
+        def pillow(image=image) -> bytes:
+            buffer = io.BytesIO()
+            image.save(buffer, format="png", compress_level=png.COMPRESS_LEVEL)
+            return buffer.getvalue()
+
+        times = {}
+        sizes = {}
+        for name, encode in (("Pillow", pillow), ("pack", lambda rgb=rgb: png.encode(rgb, 90))):
+            runs = []
+            for _ in range(10):
+                start = time.perf_counter()
+                sizes[name] = len(encode())
+                runs.append(1e3 * (time.perf_counter() - start))
+            times[name] = statistics.median(runs)
+        print(f"  {notebook:27s} Pillow {times['Pillow']:6.1f} ms ({sizes['Pillow'] // 1024} KiB), "
+              f"pack {times['pack']:6.1f} ms ({sizes['pack'] // 1024} KiB): "
+              f"{times['pack'] / times['Pillow']:.2f}x")
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--encoders", action="store_true",
+                        help="also compare the PNG writers on each explorer's picture")
+    arguments = parser.parse_args()
+    if arguments.encoders:
+        compare_encoders()
     print(f"Explorer redraw: slider value set -> PNG ready, median of {MOVES} moves, against "
           f"a plain figure of the same size rendered in between (target <= "
           f"{TARGET_RATIO}x and <= {TARGET_MS:.0f} ms on a quiet 2-core machine)")

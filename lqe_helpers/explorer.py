@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import base64
 import html
-import io
 import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass
@@ -38,9 +37,8 @@ from matplotlib.artist import Artist
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
-from PIL import Image
 
-from . import validation
+from . import png, validation
 from .explorers._layers import LayeredCanvas
 
 #: zorder of bands, bars and spans that a slider changes: above the grid and ticks
@@ -48,9 +46,6 @@ from .explorers._layers import LayeredCanvas
 #: zorder 1 they would lie under the grid, and every move would repaint each axis
 #: with its tick labels (see :class:`~lqe_helpers.explorers._layers.LayeredCanvas`).
 DATA_UNDER_LINES = 1.6
-
-#: zlib level of the explorer's PNG (0 = none … 9 = smallest); see :func:`encode_png`.
-PNG_COMPRESS_LEVEL = 1
 
 #: Signature of a drawing function: it (re)draws ``figure`` for the slider values.
 DrawFunction = Callable[..., None]
@@ -188,16 +183,13 @@ def set_ylim_in_steps(ax: Axes, low: float, high: float, step: float) -> None:
 def encode_png(rgba: np.ndarray, dpi: float) -> bytes:
     """The picture ``rgba`` (uint8, shape (h, w, 4)) as PNG bytes, fast rather than small.
 
-    zlib's fastest level: for a widget on the same machine encoding time matters
-    more than bytes (``benchmarks/bench_widgets.py`` measures the levels). An opaque
-    picture is stored as RGB, a quarter fewer bytes to compress. No metadata besides
-    the resolution, so equal pictures give equal bytes.
+    An opaque picture is stored as RGB, a quarter fewer bytes to compress; the writer
+    (:func:`lqe_helpers.png.encode`) skips row filters and uses zlib's fastest level,
+    since for a widget on the same machine encoding time matters more than bytes. No
+    metadata besides the resolution, so equal pictures give equal bytes.
     """
     opaque = bool(rgba[..., 3].min() == 255)
-    image = Image.fromarray(np.ascontiguousarray(rgba[..., :3] if opaque else rgba))
-    buffer = io.BytesIO()
-    image.save(buffer, format="png", compress_level=PNG_COMPRESS_LEVEL, dpi=(dpi, dpi))
-    return buffer.getvalue()
+    return png.encode(np.ascontiguousarray(rgba[..., :3] if opaque else rgba), dpi)
 
 
 def _check_readout_format(readout_format: str) -> None:

@@ -17,6 +17,7 @@ from explorer_checks import png
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
 from matplotlib.lines import Line2D
 from matplotlib.text import Text
 from PIL import Image
@@ -430,6 +431,37 @@ def test_fast_path_repaints_only_changed_artists_and_detects_other_changes():
     pixels = layers.render().copy()
     figure.canvas.draw()
     np.testing.assert_array_equal(pixels, np.asarray(figure.canvas.buffer_rgba()))
+
+
+def _marker_and_legend() -> tuple[Figure, Line2D, Legend]:
+    """A small figure: a fixed line, an empty marker line and a legend at lower right."""
+    figure = Figure(figsize=(4.0, 3.0), dpi=60)
+    FigureCanvasAgg(figure)
+    ax = figure.add_subplot()
+    ax.plot([0.0, 1.0], [0.0, 1.0], label="fixed")
+    (marker,) = ax.plot([], [], linestyle="none", marker="o", markersize=9, label="moving")
+    legend = ax.legend(loc="lower right")
+    ax.set_xlim(0.0, 1.0)
+    ax.set_ylim(0.0, 1.0)
+    return figure, marker, legend
+
+
+def test_a_marker_is_repainted_with_what_covers_it_only_where_it_is():
+    """A clipped line's extent is where its points and markers are, not its whole axes."""
+    figure, marker, legend = _marker_and_legend()
+    layers = LayeredCanvas(figure)
+    layers.render()
+    # Far from the legend, then under it, then beside it, then away again.
+    for x, y in ((0.1, 0.9), (0.2, 0.9), (0.3, 0.8), (0.85, 0.1), (0.5, 0.1), (0.15, 0.8),
+                 (0.2, 0.7)):
+        marker.set_data([x], [y])
+        pixels = layers.render()
+        reference, reference_marker, _ = _marker_and_legend()
+        reference_marker.set_data([x], [y])
+        reference.canvas.draw()
+        np.testing.assert_array_equal(pixels, np.asarray(reference.canvas.buffer_rgba()))
+    assert layers.fast_renders >= 3, (layers.full_renders, layers.fast_renders)
+    assert legend not in layers._background.redrawn  # far from the marker: not repainted
 
 
 def test_png_encoding_keeps_every_pixel():

@@ -219,6 +219,19 @@ def test_allow_errors_keeps_the_error_in_the_outputs(tmp_path):
     assert notebook.cells[1].outputs[0]["text"] == "still runs\n"
 
 
+def test_a_stream_is_one_output_however_the_kernel_chunked_it(tmp_path):
+    source = ("import sys, time\n"
+              "print('first', flush=True)\n"
+              "time.sleep(0.3)\n"
+              "print('second', flush=True)\n"
+              "sys.stderr.write('warning\\n')\n"
+              "print('third')")
+    notebook = notebook_runner.execute_notebook(write(tmp_path / "chunks.ipynb", source))
+    streams = {output["name"]: output["text"] for output in notebook.cells[0].outputs}
+    assert len(notebook.cells[0].outputs) == 2, notebook.cells[0].outputs
+    assert streams == {"stdout": "first\nsecond\nthird\n", "stderr": "warning\n"}
+
+
 @pytest.mark.parametrize("timeout", [0, -1.0, True, "5"])
 def test_execute_notebook_refuses_a_bad_timeout(tmp_path, timeout):
     path = write(tmp_path / "a.ipynb", "1")

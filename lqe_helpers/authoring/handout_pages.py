@@ -157,6 +157,9 @@ main { min-width: 0; }
 .MathJax_Display { overflow-x: auto; overflow-y: hidden; max-width: 100%; }
 @media (max-width: 760px) {
   .jp-InputPrompt, .jp-OutputPrompt { display: none; }
+  /* Narrow or zoomed: code wraps instead of scrolling (a scrolling box would need
+     its own keyboard focus); leading spaces keep the indentation. */
+  .jp-InputArea pre, .jp-OutputArea-output pre { white-space: pre-wrap; overflow-wrap: anywhere; }
   .jp-Notebook { padding: 4px; }
 }
 nav.lqe-nav {

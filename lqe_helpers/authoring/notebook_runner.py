@@ -68,7 +68,8 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
     """Run every cell of the notebook at ``path`` in a new kernel; return the result.
 
     Widget state is not stored (it would break across ipywidgets versions), timings
-    are not recorded, and the kernel's working directory is the notebook's folder.
+    are not recorded, consecutive pieces of one stream (stdout, stderr) are merged
+    into one output, and the kernel's working directory is the notebook's folder.
 
     Parameters
     ----------
@@ -101,6 +102,9 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
         notebook, timeout=timeout, kernel_name=kernel_name,
         resources={"metadata": {"path": str(path.parent.resolve())}},
         store_widget_state=False, record_timing=False, allow_errors=allow_errors,
+        # One output per stream: how the kernel happened to chunk its output must not
+        # make two runs of the same notebook differ.
+        coalesce_streams=True,
         on_cell_start=lambda cell, cell_index: current.append(cell_index),
     )
     # The kernel process's own stderr (start-up notices, a crash report) is kept aside

@@ -31,12 +31,15 @@ from matplotlib.axes import Axes
 from matplotlib.axis import Axis
 from matplotlib.backends.backend_agg import FigureCanvasAgg, RendererAgg
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 from matplotlib.text import Text
 from matplotlib.transforms import Bbox
 
 #: Pixels added on every side of a bounding box before testing overlap: antialiased
 #: edges, line caps and rounding of clip rectangles stay within it.
 MARGIN_PX = 3.0
+#: The extent of an artist clipped away entirely: a point far off any canvas.
+_EMPTY = Bbox([[-1e9, -1e9], [-1e9, -1e9]])
 
 
 def leaves(figure: Figure) -> list[Artist]:
@@ -72,6 +75,15 @@ def _extent(artist: Artist, renderer: RendererAgg, whole: Bbox) -> Bbox:
     clip = artist.get_clip_box() if artist.get_clip_on() else None
     if clip is not None:
         box = clip
+        # A line inside its clip box (e.g. one marker) paints only where its own
+        # extent, which includes its markers, meets the clip box.
+        if isinstance(artist, Line2D):
+            try:
+                own = artist.get_window_extent(renderer)
+            except (TypeError, RuntimeError, ValueError):
+                own = None
+            if own is not None and np.all(np.isfinite(own.get_points())):
+                box = Bbox.intersection(clip, own.padded(MARGIN_PX)) or _EMPTY
     elif isinstance(artist, Axis):
         parts = [artist.axes.bbox]
         tight = artist.get_tightbbox(renderer)

@@ -95,7 +95,9 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
     growth_ax.set_xlabel("time since the last measurement (s)")
     growth_ax.set_ylabel("2σ of predicted position (cm)")
-    growth_ax.legend(loc="lower right", fontsize=8)
+    # Legends below the panels, never over a moving curve: a legend a curve passes
+    # under has to be painted again on every slider move.
+    growth_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=2)
 
     times = scenario.times
     window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
@@ -107,8 +109,8 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     track_ax.set_xlim(*TRACKING_WINDOW)
     track_ax.xaxis.set_major_locator(MultipleLocator(1.0))  # fewer labels: faster redraws
     label_time_position(track_ax)
-    track_ax.legend(loc="upper center", fontsize=8, ncols=3)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.13, wspace=0.22)
+    track_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=3)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.25, wspace=0.22)
     return _Panels((growth_ax, track_ax), growth, vision, estimate)
 
 
@@ -192,6 +194,6 @@ def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
         "Jerk noise σ_j: open-loop growth and tracking",
         {"jerk_std": slider},
         partial(draw_background, scenario=scenario, noise=noise),
-        figsize=(10.0, 4.2),
+        figsize=(10.0, 4.8),
         describe=partial(describe_background, scenario=scenario),
     )

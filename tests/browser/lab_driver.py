@@ -500,6 +500,9 @@ def explorers(panel: Locator) -> list[ExplorerView]:
 def iter_sliders(view: ExplorerView) -> Iterator[tuple[str, Locator]]:
     """(description, slider) for each slider of ``view``."""
     for slider in view.sliders:
+        # Scrolled into view first, as a student would: JupyterLab does not render
+        # cells far off screen, and text that is not rendered reads as empty.
+        slider.scroll_into_view_if_needed(timeout=UI_MS)
         yield slider.locator(".widget-label").inner_text().strip(), slider
 
 
@@ -562,9 +565,11 @@ def exercise_slider(view: ExplorerView, slider: Locator, what: str,
 
     Raises AssertionError naming ``what`` at the first step that fails.
     """
+    slider.scroll_into_view_if_needed(timeout=UI_MS)
     start = image_state(view.image)
     assert start["loaded"], f"{what}: the explorer's image is not loaded before any move"
     start_text = readout(slider).inner_text().strip()
+    assert start_text, f"{what}: the slider's readout shows no value"
 
     key = press_slider_key(slider)
     at_end = wait_for_new_image(view.image, start, f"{what}, key {key}", timeout_ms)
