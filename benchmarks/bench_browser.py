@@ -28,6 +28,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "browser"
 
 # The shared helpers live beside the browser tests.
 import lab_driver
+from bench_widgets import EXPLORERS  # (notebook, module, factory) of every explorer
 from lab_driver import (
     CHROMIUM_ARGS,
     REPO_ROOT,
@@ -37,18 +38,6 @@ from lab_driver import (
     open_notebook,
 )
 
-#: (name, module, factory) of every explorer in the pack.
-EXPLORERS = [
-    ("00 background", "lqe_helpers.explorers.background", "explore_background"),
-    ("01 vision only", "lqe_helpers.explorers.vision", "explore_vision"),
-    ("02 initial covariance", "lqe_helpers.explorers.initial_covariance",
-     "explore_initial_covariance"),
-    ("03 fusion", "lqe_helpers.explorers.fusion", "explore_fusion"),
-    ("04 noisier proprioception", "lqe_helpers.explorers.noisier_proprioception",
-     "explore_noisier_proprioception"),
-    ("05 sensory delay", "lqe_helpers.explorers.delay", "explore_delay"),
-    ("06 bias and input", "lqe_helpers.explorers.bias", "explore_bias"),
-]
 #: Key presses timed per explorer (after two untimed ones that warm the cache).
 PRESSES = 10
 WARM_UP = 2

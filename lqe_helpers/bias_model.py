@@ -212,7 +212,8 @@ def dead_reckoning(readings: np.ndarray, start: np.ndarray, dt: float,
     Returns
     -------
     ndarray, shape (..., n, 3)
-        ``[p, v, b̂]`` after each reading.
+        ``[p, v, b̂]`` after each reading. Computed with running sums (the recursion
+        solved for each sample), equal to the step-by-step recursion to rounding.
     """
     readings = validation.finite_array("readings", readings, min_ndim=1)
     start = validation.finite_array("start", start, min_ndim=1)
@@ -221,18 +222,24 @@ def dead_reckoning(readings: np.ndarray, start: np.ndarray, dt: float,
             f"start must have trailing length 2 [p, v] or 3 [p, v, b], got shape {start.shape}"
         )
     bias_estimate = validation.finite_number("bias_estimate", bias_estimate, "cm/s²")
-    F = transition_matrix(dt)
-    G = input_matrix(dt)[:, 0]
+    dt = validation.positive("dt", dt, "s")
     batch = validation.broadcast_batches(readings=readings.shape[:-1], start=start.shape[:-1])
     n_steps = readings.shape[-1]
-    z = np.empty((*batch, 3))
-    z[..., :2] = start[..., :2]
-    z[..., 2] = bias_estimate
-    readings = np.broadcast_to(readings, (*batch, n_steps))
+    # The recursion solved with running sums: with w_i = u_i − b̂ and S_j = Σ_{i≤j} w_i,
+    # v_j = v_start + Δt S_j and p_j = p_start + (j + 1) Δt v_start
+    # + Δt² (Σ_{i<j} S_i + S_j / 2), the rows of F and G written out (p gains Δt v_{j−1}
+    # + Δt²/2 w_j per step).
+    corrected = np.broadcast_to(readings, (*batch, n_steps)) - bias_estimate
+    sums = np.cumsum(corrected, axis=-1)
+    earlier = np.zeros_like(sums)
+    earlier[..., 1:] = np.cumsum(sums[..., :-1], axis=-1)
+    position = np.broadcast_to(start[..., 0], batch)[..., None]
+    velocity = np.broadcast_to(start[..., 1], batch)[..., None]
+    elapsed = dt * np.arange(1, n_steps + 1)
     out = np.empty((*batch, n_steps, 3))
-    for j in range(n_steps):
-        z = z @ F.T + readings[..., j, None] * G
-        out[..., j, :] = z
+    out[..., 0] = position + elapsed * velocity + dt * dt * (earlier + sums / 2.0)
+    out[..., 1] = velocity + dt * sums
+    out[..., 2] = bias_estimate
     return out
 
 
@@ -290,6 +297,48 @@ def unit_noise(scenario: Scenario, runs: int | None = None) -> np.ndarray:
     rng = np.random.default_rng(scenario.seed)
     noise = simulation.unit_noise(rng, scenario.n_steps, streams, runs=runs)
     return noise[..., [model.SENSORS.index("vision"), streams - 1]]
+
+
+def filter_model(scenario: Scenario, sigma_a: float, sigma_v: float,
+                 bias_prior_std: float = DEFAULT_BIAS_PRIOR_STD) -> dict[str, np.ndarray]:
+    """The model the filter of :func:`track_with_input` assumes, as keyword arguments.
+
+    ``A = F`` and ``B = G`` (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)),
+    ``C = [1, 0, 0]``, ``R = σ_v²``, ``z0 = [0, 0, 0]`` and
+    ``P0 = diag(A², (A·2πf)², bias_prior_std²)``: one amplitude A for position, the
+    path's peak speed for velocity. Pass them to
+    :func:`~lqe_helpers.filter.kalman_filter` with the measurements and the input u.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies Δt and the path's amplitude and frequency.
+    sigma_a : float
+        Noise σ_a of the acceleration signal in cm/s², > 0.
+    sigma_v : float
+        Vision noise σ_v in cm, > 0.
+    bias_prior_std : float
+        The prior standard deviation of the bias in cm/s², > 0.
+
+    Returns
+    -------
+    dict
+        ``A`` (3, 3), ``C`` (1, 3), ``Q`` (3, 3), ``R`` (1, 1), ``z0`` (3,), ``P0`` (3, 3)
+        and ``B`` (3, 1).
+    """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
+    bias_prior_std = validation.positive("bias_prior_std", bias_prior_std, "cm/s²")
+    dt = scenario.dt
+    return {
+        "A": transition_matrix(dt),
+        "C": model.observation_matrix(("vision",)),
+        "Q": process_noise_covariance(dt, sigma_a),
+        "R": model.measurement_noise_covariance([sigma_v]),
+        "z0": np.zeros(3),
+        "P0": np.diag([scenario.amplitude**2, scenario.peak_speed**2, bias_prior_std**2]),
+        "B": input_matrix(dt),
+    }
 
 
 @dataclass(frozen=True)
@@ -362,10 +411,10 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
 
     The filter is :func:`~lqe_helpers.filter.kalman_filter` with ``A = F``, ``B = G``
     (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)), ``C = [1, 0, 0]`` and
-    ``R = σ_v²``. It starts from ``z0 = [0, 0, 0]`` with prior standard deviations
-    of one amplitude A for position, the path's peak speed A·2πf for velocity and
-    ``bias_prior_std`` for the bias: the observer knows the range of the movement
-    and roughly how large a bias can be, nothing more.
+    ``R = σ_v²`` (:func:`filter_model`). It starts from ``z0 = [0, 0, 0]`` with prior
+    standard deviations of one amplitude A for position, the path's peak speed A·2πf
+    for velocity and ``bias_prior_std`` for the bias: the observer knows the range of
+    the movement and roughly how large a bias can be, nothing more.
 
     Parameters
     ----------
@@ -406,12 +455,9 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
     readings = acceleration_readings(step_accelerations(scenario), bias, sigma_a,
                                      noise[..., 1])
     measurements = simulation.measure(truth[:, 0], noise[..., :1], np.array([sigma_v]))
-    P0 = np.diag([scenario.amplitude**2, scenario.peak_speed**2, bias_prior_std**2])
-    result = kalman_filter(
-        measurements, transition_matrix(dt), model.observation_matrix(("vision",)),
-        process_noise_covariance(dt, sigma_a), model.measurement_noise_covariance([sigma_v]),
-        np.zeros(3), P0, B=input_matrix(dt), u=readings[..., None],
-    )
+    result = kalman_filter(measurements, **filter_model(scenario, sigma_a, sigma_v,
+                                                        bias_prior_std),
+                           u=readings[..., None])
     drift = dead_reckoning(readings, initial_state(scenario, bias), dt)
     return InputTracking(scenario, bias, sigma_a, sigma_v, truth, readings, measurements,
                          result, drift)

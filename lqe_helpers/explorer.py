@@ -47,8 +47,9 @@ from .explorers._layers import LayeredCanvas
 #: with its tick labels (see :class:`~lqe_helpers.explorers._layers.LayeredCanvas`).
 DATA_UNDER_LINES = 1.6
 
-#: Signature of a drawing function: it (re)draws ``figure`` for the slider values.
-DrawFunction = Callable[..., None]
+#: Signature of a drawing function: it (re)draws ``figure`` for the slider values and
+#: returns the numbers of this view as one line of plain text (or None).
+DrawFunction = Callable[..., "str | None"]
 
 #: Whatever a panel builder returns: artists, possibly in tuples, lists or dicts.
 Panels = TypeVar("Panels")
@@ -344,7 +345,10 @@ class Explorer:
         Keyword name of each value passed to ``draw`` → its slider.
     draw : callable
         ``draw(figure, **values)``: draws everything on ``figure`` (clearing it first
-        if it needs to); must not call pyplot.
+        if it needs to) and returns the numbers of this view (this run's MSEs, a gain,
+        …) as one line of plain text, or None; must not call pyplot. The line is shown
+        between the sliders and the figure (:attr:`numbers`), not drawn in the figure:
+        text is the costliest thing to render again on every move.
     figsize : (float, float)
         Figure size in inches; with ``dpi`` it fixes the image's height on the page.
     dpi : int
@@ -369,6 +373,9 @@ class Explorer:
         FigureCanvasAgg(self.figure)
         self.layers = LayeredCanvas(self.figure)
         width, height = (round(size * dpi) for size in figsize)
+        #: The numbers of the current view, as ``draw`` returned them ("" for none).
+        self.numbers = ""
+        self.readout = widgets.HTML(layout=widgets.Layout(margin="0 0 0 8px"))
         self.image = widgets.Image(
             format="png",
             layout=widgets.Layout(width=f"{width}px", height=f"{height}px",
@@ -378,7 +385,8 @@ class Explorer:
             slider.observe(self._on_change, names="value")
         self.widget = widgets.VBox(
             [widgets.HBox(list(self.sliders.values()),
-                          layout=widgets.Layout(flex_flow="row wrap")), self.image]
+                          layout=widgets.Layout(flex_flow="row wrap")),
+             self.readout, self.image]
         )
         self.png = b""
         #: Slider values the explorer started at, by keyword name.
@@ -408,8 +416,12 @@ class Explorer:
         of the rest (:class:`~lqe_helpers.explorers._layers.LayeredCanvas`); the
         picture is the same as a full rendering.
         """
-        self.draw(self.figure, **self.values)
+        numbers = self.draw(self.figure, **self.values)
+        if numbers is not None and not isinstance(numbers, str):
+            raise TypeError(f"draw must return a str or None, got {type(numbers).__name__}")
         self.png = encode_png(self.layers.render(), self.dpi)
+        self.numbers = numbers or ""
+        self.readout.value = html.escape(self.numbers)
         self.image.value = self.png
 
     def _on_change(self, change: Mapping[str, object]) -> None:
@@ -418,9 +430,9 @@ class Explorer:
     def static_html(self) -> str:
         """The figure at the current values as an embedded image, with a note.
 
-        The note lists every slider's current value (as its readout shows it) and says
+        The note lists every slider's current value (as its readout shows it), says
         whether these are the explorer's default values, since a reader of a static
-        page cannot see the sliders.
+        page cannot see the sliders, and gives the view's :attr:`numbers`.
         """
         encoded = base64.b64encode(self.png).decode("ascii")
         shown = "; ".join(
@@ -430,9 +442,10 @@ class Explorer:
         return (
             f'<figure class="lqe-explorer"><img alt="{html.escape(self.description)}" '
             f'src="data:image/png;base64,{encoded}"/>'
-            f"<figcaption><em>{html.escape(self.title)}, shown at {html.escape(at)}. "
-            f"Open the notebook in JupyterLab to move the sliders."
-            f"</em></figcaption></figure>"
+            f"<figcaption><em>{html.escape(self.title)}, shown at {html.escape(at)}.</em>"
+            + (f" {html.escape(self.numbers)}" if self.numbers else "")
+            + " <em>Open the notebook in JupyterLab to move the sliders.</em>"
+            "</figcaption></figure>"
         )
 
     def _repr_mimebundle_(self, **kwargs: object) -> dict[str, object]:

@@ -84,6 +84,71 @@ def test_uncorrected_bias_drifts_as_half_b_t_squared(bias: float) -> None:
     np.testing.assert_allclose(corrected[:, :2], clean[:, :2], rtol=0, atol=1e-9)
 
 
+def step_by_step_dead_reckoning(readings, start, dt, bias_estimate=0.0):
+    """The recursion z_j = F z_{j−1} + G u_j one step at a time (the former implementation)."""
+    readings, start = np.asarray(readings, float), np.asarray(start, float)
+    F = bias_model.transition_matrix(dt)
+    G = bias_model.input_matrix(dt)[:, 0]
+    batch = np.broadcast_shapes(readings.shape[:-1], start.shape[:-1])
+    n_steps = readings.shape[-1]
+    z = np.empty((*batch, 3))
+    z[..., :2] = start[..., :2]
+    z[..., 2] = bias_estimate
+    readings = np.broadcast_to(readings, (*batch, n_steps))
+    out = np.empty((*batch, n_steps, 3))
+    for j in range(n_steps):
+        z = z @ F.T + readings[..., j, None] * G
+        out[..., j, :] = z
+    return out
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_dead_reckoning_equals_the_step_by_step_recursion(seed: int) -> None:
+    """Running sums give the recursion's values, to 1e-9 relative on random inputs."""
+    rng = np.random.default_rng(seed)
+    n_steps = int(rng.integers(1, 1500))
+    dt = float(10.0 ** rng.uniform(-3, -0.5))
+    shapes = [((n_steps,), (3,)), ((4, n_steps), (2,)), ((n_steps,), (5, 3)),
+              ((2, 1, n_steps), (3, 2)), ((3, n_steps), (3, 2)), ((n_steps,), (2,))]
+    readings_shape, start_shape = shapes[seed]
+    readings = rng.normal(20.0, 300.0, readings_shape)
+    start = rng.normal(0.0, 50.0, start_shape)
+    bias_estimate = float(rng.normal(0.0, 30.0))
+    fast = bias_model.dead_reckoning(readings, start, dt, bias_estimate)
+    slow = step_by_step_dead_reckoning(readings, start, dt, bias_estimate)
+    assert fast.shape == slow.shape
+    # Relative to each quantity's largest size: where p or v crosses zero, both ways of
+    # summing round differently in the last digits of a much larger running sum.
+    for column, name in enumerate(("p", "v", "b̂")):
+        scale = float(np.max(np.abs(slow[..., column])))
+        np.testing.assert_allclose(fast[..., column], slow[..., column], rtol=1e-9,
+                                   atol=1e-9 * scale, err_msg=name)
+    np.testing.assert_array_equal(fast[..., 2], bias_estimate)
+
+
+def test_filter_model_is_the_one_track_with_input_uses() -> None:
+    """Lesson 0.5 eqs. (5) and (9), vision reading the position, P0 spanning the path."""
+    scenario = dataclasses.replace(DEFAULT, amplitude=4.0, frequency=1.5)
+    model = bias_model.filter_model(scenario, sigma_a=30.0, sigma_v=2.5, bias_prior_std=40.0)
+    dt = scenario.dt
+    np.testing.assert_array_equal(model["A"], [[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
+    np.testing.assert_array_equal(model["B"], [[dt**2 / 2], [dt], [0]])
+    np.testing.assert_allclose(model["Q"], 900.0 * model["B"] @ model["B"].T, rtol=1e-15)
+    np.testing.assert_array_equal(model["C"], [[1.0, 0.0, 0.0]])
+    np.testing.assert_array_equal(model["R"], [[6.25]])
+    np.testing.assert_array_equal(model["z0"], np.zeros(3))
+    np.testing.assert_allclose(model["P0"], np.diag([16.0, (4.0 * 2 * np.pi * 1.5) ** 2, 1600.0]),
+                               rtol=1e-15)
+    tracking = bias_model.track_with_input(scenario, bias=5.0, sigma_a=30.0, sigma_v=2.5,
+                                           bias_prior_std=40.0)
+    direct = kalman_filter(tracking.measurements, **model, u=tracking.readings[:, None])
+    np.testing.assert_array_equal(tracking.result.estimates, direct.estimates)
+    for name, value in (("sigma_a", 0.0), ("sigma_v", -1.0), ("bias_prior_std", 0.0)):
+        arguments = {"sigma_a": 30.0, "sigma_v": 2.5, "bias_prior_std": 40.0, name: value}
+        with pytest.raises(ValueError, match=name):
+            bias_model.filter_model(scenario, **arguments)
+
+
 def test_dead_reckoning_spread_matches_monte_carlo_and_power_law() -> None:
     sigma_a = 20.0
     spread = bias_model.dead_reckoning_spread(DEFAULT, sigma_a)

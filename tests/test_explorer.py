@@ -47,6 +47,31 @@ def make_explorer() -> Explorer:
                     draw_line, figsize=(4.0, 3.0), dpi=50)
 
 
+def draw_line_with_numbers(figure, *, slope):
+    draw_line(figure, slope=slope)
+    return f"rise over one unit: {slope:g} cm <ok>"
+
+
+def test_the_numbers_of_a_view_go_beside_the_figure_and_into_the_static_caption():
+    explorer = Explorer("a test line", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
+                        draw_line_with_numbers, figsize=(4.0, 3.0), dpi=50)
+    assert explorer.numbers == "rise over one unit: 1 cm <ok>"
+    assert explorer.readout.value == "rise over one unit: 1 cm &lt;ok&gt;"
+    assert explorer.widget.children.index(explorer.readout) == 1  # sliders, numbers, image
+    explorer.sliders["slope"].value = 2.5
+    assert explorer.readout.value == "rise over one unit: 2.5 cm &lt;ok&gt;"
+    assert "rise over one unit: 2.5 cm &lt;ok&gt;" in explorer.static_html()
+    silent = make_explorer()  # draw returns None: no numbers, an empty line
+    assert (silent.numbers, silent.readout.value) == ("", "")
+    assert "rise" not in silent.static_html()
+
+
+def test_a_drawing_that_returns_something_else_is_refused():
+    with pytest.raises(TypeError, match="draw must return a str or None, got float"):
+        Explorer("bad", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
+                 lambda figure, slope: 1.0, figsize=(4.0, 3.0), dpi=50)
+
+
 def test_slider_conventions():
     linear = float_slider("σ_v (cm)", 1.5, 0.5, 5.0, 0.1, readout_format=".1f")
     assert (linear.min, linear.max, linear.value) == (0.5, 5.0, 1.5)

@@ -3,12 +3,16 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
 
 import numpy as np
 import pytest
 from explorer_checks import line, png
+from matplotlib.axis import Tick
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.text import Text
 
 from lqe_helpers import experiments, model
 from lqe_helpers.explorers import background
@@ -72,20 +76,47 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
     expected = experiments.track(dataclasses.replace(DEFAULT, jerk_std=jerk_std), noise=noise)
     np.testing.assert_allclose(line(track_ax, background.ESTIMATE_LABEL),
                                expected.positions[shown], rtol=0, atol=1e-12)
-    assert f"MSE {float(expected.mse()):.3g} cm²" in track_ax.get_title()
-    assert f"σ_j = {background.format_jerk(jerk_std)} cm/s³" in growth_ax.get_title()
+    # The numbers go to the line beside the figure; the panels' titles never change.
+    numbers = explorer.numbers
+    assert numbers.startswith(f"σ_j = {background.format_jerk(jerk_std)} cm/s³. ")
+    skip = DEFAULT.burn_in_steps
+    mse = np.mean((expected.positions - truth)[skip:] ** 2)
+    expects = np.mean(expected.position_variances[skip:])
+    assert numbers.endswith(f"Tracking MSE of this run after {DEFAULT.burn_in:g} s: "
+                            f"{mse:.3g} cm², the filter expects {expects:.3g} cm².")
+    assert (growth_ax.get_title(), track_ax.get_title()) == (background.GROWTH_TITLE,
+                                                             background.TRACKING_TITLE)
     assert explorer.png != previous_png
 
 
-def test_title_gives_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
+def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
+    """Text is the costliest artist to repaint: the numbers live beside the figure."""
+
+    def texts() -> list[str]:  # tick labels follow the axis limits: left out
+        ticks = {label for tick in explorer.figure.findobj(Tick)
+                 for label in (tick.label1, tick.label2)}
+        return [text.get_text() for text in explorer.figure.findobj(Text) if text not in ticks]
+
+    before, numbers = texts(), explorer.numbers
+    explorer.sliders["jerk_std"].value = 10.0
+    assert texts() == before
+    assert explorer.numbers != numbers
+    # Nor is any text (titles, legends, labels) painted again over the moving data.
+    repainted = explorer.layers._background.redrawn
+    assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]
+
+
+def test_numbers_give_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
     growth = direct_growth(DEFAULT.process_jerk_std)
     first = int(np.argmax(growth >= DEFAULT.amplitude))
     assert first > 0
-    growth_ax = explorer.figure.axes[0]
-    assert f"after {first * DEFAULT.dt:.2f} s" in growth_ax.get_title()
+    reaches = ("2σ of the predicted position reaches the flight's amplitude of "
+               f"{DEFAULT.amplitude:g} cm")
+    assert f"{reaches} after {first * DEFAULT.dt:.2f} s. " in explorer.numbers
     # Very small σ_j: never within the second shown.
+    assert not np.any(direct_growth(10.0) >= DEFAULT.amplitude)
     explorer.sliders["jerk_std"].value = 10.0
-    assert "after > 1 s" in explorer.figure.axes[0].get_title()
+    assert f"{reaches} after more than {background.OPEN_LOOP_DURATION:g} s. " in explorer.numbers
 
 
 def test_lag_and_noise_show_in_the_tracking_error(explorer) -> None:
@@ -114,7 +145,7 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
 def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
     figure = Figure()
     noise = np.zeros((DEFAULT.n_steps, 1))
-    background.draw_background(figure, jerk_std=500.0, noise=noise)
+    numbers = background.draw_background(figure, jerk_std=500.0, noise=noise)
     growth_ax, track_ax = figure.axes
     np.testing.assert_allclose(line(growth_ax, background.GROWTH_LABEL), direct_growth(500.0),
                                rtol=1e-9)
@@ -124,6 +155,8 @@ def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
     expected = experiments.track(dataclasses.replace(DEFAULT, jerk_std=500.0), noise=noise)
     np.testing.assert_allclose(line(track_ax, background.ESTIMATE_LABEL),
                                expected.positions[shown], rtol=0, atol=1e-12)
+    assert (f"Tracking MSE of this run after {DEFAULT.burn_in:g} s: "
+            f"{float(expected.mse()):.3g} cm², ") in numbers
     # Drawing again replaces, not adds.
     background.draw_background(figure, jerk_std=800.0, noise=noise)
     assert len(figure.axes) == 2
@@ -141,6 +174,8 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_j (cm/s³)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+    assert explorer.numbers.startswith(f"σ_j = {DEFAULT.process_jerk_std:,.0f} cm/s³. ")
+    assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
@@ -161,9 +196,10 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     labels = [line.get_label() for ax in figure.axes for line in ax.get_lines()]
     assert "someone else's line" not in labels
     figure.clear()
-    background.draw_background(figure, jerk_std=2000.0)
+    numbers = background.draw_background(figure, jerk_std=2000.0)
     growth_ax, track_ax = figure.axes
-    assert "σ_j = 2,000 cm/s³" in growth_ax.get_title()
+    assert numbers.startswith("σ_j = 2,000 cm/s³. ")
+    assert growth_ax.get_title() == background.GROWTH_TITLE
     assert len(growth_ax.get_lines()) == 3
     assert len(track_ax.get_lines()) == 3
 

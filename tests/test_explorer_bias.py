@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from explorer_checks import band_matches, line, png
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from lqe_helpers import bias_model, model
 from lqe_helpers.explorers import bias as bias_explorer
@@ -29,6 +30,40 @@ def direct_filter(bias: float, sigma_a: float, sigma_v: float, noise: np.ndarray
     P0 = np.diag([DEFAULT.amplitude**2, speed**2, bias_model.DEFAULT_BIAS_PRIOR_STD**2])
     return kalman_filter(y, F, model.observation_matrix(("vision",)), G @ G.T * sigma_a**2,
                          np.array([[sigma_v**2]]), np.zeros(3), P0, B=G, u=readings[:, None])
+
+
+def direct_dead_reckoning(bias: float, sigma_a: float, noise: np.ndarray) -> np.ndarray:
+    """Positions (cm) of the signal integrated step by step from the true start, b̂ = 0."""
+    dt = DEFAULT.dt
+    readings = bias_model.step_accelerations(DEFAULT) + bias + sigma_a * noise[:, 1]
+    omega = 2 * np.pi * DEFAULT.frequency
+    p, v = DEFAULT.amplitude * np.sin(-omega * dt), DEFAULT.amplitude * omega * np.cos(-omega * dt)
+    positions = []
+    for reading in readings:
+        p, v = p + dt * v + dt**2 / 2 * reading, v + dt * reading
+        positions.append(p)
+    return np.array(positions)
+
+
+def check_numbers(numbers: str, values: dict[str, float], noise: np.ndarray) -> None:
+    """The line of text states b, b̂ ± 2σ at the end, the MSE and dead reckoning's end error."""
+    bias = values["bias"]
+    expected = direct_filter(bias, values["sigma_a"], values["sigma_v"], noise)
+    truth = DEFAULT.truth[:, 0]
+    end = f"{DEFAULT.duration:g} s"
+    assert f"b = {bias:g} cm/s²" in numbers
+    final, std = expected.estimates[-1, 2], np.sqrt(expected.estimate_covariances[-1, 2, 2])
+    assert f"estimate at {end}: {final:.1f} ± {2 * std:.1f} cm/s²" in numbers
+    skip = DEFAULT.burn_in_steps
+    mse = np.mean((expected.estimates[skip:, 0] - truth[skip:]) ** 2)
+    assert f"after {DEFAULT.burn_in:g} s: {mse:.3g} cm²" in numbers
+    off = direct_dead_reckoning(bias, values["sigma_a"], noise)[-1] - truth[-1]
+    assert f"dead reckoning ends {off:+.0f} cm off the path at {end}" in numbers
+
+
+def texts(figure: Figure) -> list[str]:
+    """Every non-empty text the figure draws (titles, labels, legends, tick labels)."""
+    return sorted(t.get_text() for t in figure.findobj(Text) if t.get_text())
 
 
 @pytest.fixture
@@ -87,8 +122,64 @@ def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
     np.testing.assert_allclose(drift - unbiased,
                                bias_model.bias_drift(DEFAULT, values["bias"])[SHOWN],
                                rtol=1e-9, atol=1e-9)
-    assert f"b = {values['bias']:g} cm/s²" in bias_ax.get_title()
+    check_numbers(explorer.numbers, values, noise)
     assert explorer.png != previous_png
+
+
+def test_the_numbers_go_beside_the_figure_and_its_text_stays_put(explorer) -> None:
+    """Text is the costliest thing to repaint: a move changes the line, not the figure's text."""
+    before, numbers = texts(explorer.figure), explorer.numbers
+    bias_ax, path_ax = explorer.figure.axes
+    assert (bias_ax.get_title(), path_ax.get_title()) == (bias_explorer.BIAS_TITLE,
+                                                          bias_explorer.PATH_TITLE)
+    assert explorer.figure.get_suptitle() == ""
+    for name, value in (("bias", -40.0), ("sigma_a", 100.0), ("sigma_v", 3.5)):
+        explorer.sliders[name].value = value
+        assert texts(explorer.figure) == before, name
+        assert explorer.numbers != numbers, name
+        numbers = explorer.numbers
+    check_numbers(explorer.numbers, explorer.values, bias_model.unit_noise(DEFAULT))
+    assert explorer.numbers in explorer._repr_mimebundle_()["text/html"]
+
+
+def test_a_move_recomputes_only_what_its_slider_changes(explorer, monkeypatch) -> None:
+    """The filter's covariances hang on (σ_a, σ_v), dead reckoning on (b, σ_a); one of each
+    is kept, so a σ moved back to an earlier value is paid for again."""
+    calls = {"filter": 0, "dead reckoning": 0}
+
+    def counted(name, function):
+        def wrapper(*args, **kwargs):
+            calls[name] += 1
+            return function(*args, **kwargs)
+        return wrapper
+
+    monkeypatch.setattr(bias_explorer, "kalman_filter",
+                        counted("filter", bias_explorer.kalman_filter))
+    monkeypatch.setattr(bias_model, "dead_reckoning",
+                        counted("dead reckoning", bias_model.dead_reckoning))
+    noise = bias_model.unit_noise(DEFAULT)
+    start = explorer.sliders["sigma_v"].value
+    # (slider, value, filter runs, dead reckonings) of each move.
+    for name, value, filters, reckonings in [("bias", -30.0, 0, 1), ("sigma_v", 3.0, 1, 0),
+                                             ("sigma_v", start, 1, 0), ("sigma_a", 40.0, 1, 1),
+                                             ("bias", 20.0, 0, 1), ("bias", -30.0, 0, 1),
+                                             ("sigma_a", 20.0, 1, 1)]:
+        before = dict(calls)
+        explorer.sliders[name].value = value
+        assert (calls["filter"] - before["filter"],
+                calls["dead reckoning"] - before["dead reckoning"]) == (filters, reckonings), (
+            name, value)
+        # What is drawn is still the library's run at these values.
+        values = explorer.values
+        run = bias_model.track_with_input(DEFAULT, noise=noise, **values)
+        bias_ax, path_ax = explorer.figure.axes
+        np.testing.assert_allclose(line(bias_ax, bias_explorer.BIAS_ESTIMATE_LABEL),
+                                   run.bias_estimates[SHOWN], rtol=0, atol=1e-9)
+        np.testing.assert_allclose(line(path_ax, bias_explorer.ESTIMATE_LABEL),
+                                   run.positions[SHOWN], rtol=0, atol=1e-9)
+        np.testing.assert_array_equal(line(path_ax, bias_explorer.DEAD_RECKONING_LABEL),
+                                      run.dead_reckoning[SHOWN, 0])
+        check_numbers(explorer.numbers, values, noise)
 
 
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
@@ -185,9 +276,11 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     bias_ax, path_ax = figure.axes
     assert "someone else's line" not in [line.get_label() for line in path_ax.get_lines()]
     figure.clear()
-    bias_explorer.draw_bias(figure, bias=-10.0, sigma_a=20.0, sigma_v=1.5)
+    numbers = bias_explorer.draw_bias(figure, bias=-10.0, sigma_a=20.0, sigma_v=1.5)
     bias_ax, path_ax = figure.axes
-    assert "b = -10 cm/s²" in bias_ax.get_title()
+    check_numbers(numbers, {"bias": -10.0, "sigma_a": 20.0, "sigma_v": 1.5},
+                  bias_model.unit_noise(DEFAULT))
+    assert bias_ax.get_title() == bias_explorer.BIAS_TITLE
     assert len(bias_ax.get_lines()) == 2
     assert len(path_ax.get_lines()) == 4
 

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 from explorer_checks import fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from lqe_helpers import experiments
 from lqe_helpers.explorers.delay import MAX_DELAY, WINDOW, draw_delay, explore_delay
@@ -60,8 +61,14 @@ def _independent(delay: float, noise: np.ndarray, sigma_v: float = DEFAULT.sigma
     }
 
 
-def _check_figure(figure: Figure, delay: float, noise: np.ndarray,
+def _texts(figure: Figure) -> list[str]:
+    """Every non-empty text the figure draws (titles, labels, legend, tick labels)."""
+    return sorted(t.get_text() for t in figure.findobj(Text) if t.get_text())
+
+
+def _check_figure(figure: Figure, numbers: str, delay: float, noise: np.ndarray,
                   sigma_v: float = DEFAULT.sigma_v) -> None:
+    """The figure shows, and ``numbers`` (the returned line of text) states, one run."""
     expected = _independent(delay, noise, sigma_v)
     lines = _lines(figure)
     assert set(lines) == set(expected["lines"])
@@ -73,11 +80,14 @@ def _check_figure(figure: Figure, delay: float, noise: np.ndarray,
     for gid in ("vision", "delayed", "prediction"):
         assert np.all(np.isnan(lines[gid][:steps])), gid
         assert np.all(np.isfinite(lines[gid][steps:])), gid
-    title = figure.get_suptitle()
-    assert f"d = {delay:.2f} s" in title
-    assert f"δ = {steps} steps" in title
+    assert f"d = {delay:.2f} s" in numbers
+    assert f"δ = {steps} steps" in numbers
     for name, value in expected["mse"].items():
-        assert f"{name} {value:.2f} cm²" in title, (name, title)
+        assert f"{name} {value:.2f} cm²" in numbers, (name, numbers)
+    # The numbers are beside the figure, not in it.
+    assert figure.get_suptitle() == ""
+    assert not [text for text in _texts(figure)
+                if "MSE" in text or "cm²" in text or "δ =" in text]
     # Every finite value is inside its axes' limits, however far a prediction overshoots.
     for ax in figure.axes:
         low, high = ax.get_ylim()
@@ -114,7 +124,7 @@ def test_slider_conventions():
 def test_initial_figure_is_the_question_delay():
     explorer = explore_delay()
     noise = DEFAULT.unit_noise(sensors=("vision",))
-    _check_figure(explorer.figure, DEFAULT.delay, noise)
+    _check_figure(explorer.figure, explorer.numbers, DEFAULT.delay, noise)
     assert explorer.png.startswith(b"\x89PNG")
 
 
@@ -123,7 +133,8 @@ def test_slider_value_redraws_the_direct_computation(delay):
     explorer = explore_delay()
     before = explorer.png
     explorer.sliders["delay"].value = delay
-    _check_figure(explorer.figure, delay, DEFAULT.unit_noise(sensors=("vision",)))
+    _check_figure(explorer.figure, explorer.numbers, delay,
+                  DEFAULT.unit_noise(sensors=("vision",)))
     assert explorer.png != before
 
 
@@ -143,7 +154,8 @@ def test_noise_stays_fixed_across_slider_moves():
 def test_slider_value_between_steps_is_rounded_to_a_step():
     explorer = explore_delay()
     explorer.sliders["delay"].value = 0.1240000001
-    _check_figure(explorer.figure, 0.12, DEFAULT.unit_noise(sensors=("vision",)))
+    _check_figure(explorer.figure, explorer.numbers, 0.12,
+                  DEFAULT.unit_noise(sensors=("vision",)))
 
 
 def test_redraw_reuses_axes_and_keeps_one_band():
@@ -153,25 +165,39 @@ def test_redraw_reuses_axes_and_keeps_one_band():
         explorer.sliders["delay"].value = delay
     assert explorer.figure.axes == axes
     assert len(axes) == 2
-    _check_figure(explorer.figure, 0.3, DEFAULT.unit_noise(sensors=("vision",)))
+    _check_figure(explorer.figure, explorer.numbers, 0.3,
+                  DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_slider_moves_change_the_numbers_line_not_the_figure_text():
+    """Text is the costliest thing to repaint: a move changes only the line beside the figure."""
+    explorer = explore_delay()
+    explorer.sliders["delay"].value = 0.05
+    texts, numbers = _texts(explorer.figure), explorer.numbers
+    limits = [ax.get_ylim() for ax in explorer.figure.axes]
+    explorer.sliders["delay"].value = 0.15  # both axes keep their limits, so their ticks
+    assert [ax.get_ylim() for ax in explorer.figure.axes] == limits
+    assert explorer.numbers != numbers
+    assert _texts(explorer.figure) == texts
+    assert explorer.numbers in explorer.static_html()
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise():
     figure = fresh_figure()
     noise = np.random.default_rng(11).standard_normal((DEFAULT.n_steps, 1))
-    draw_delay(figure, delay=0.17, noise=noise)
-    _check_figure(figure, 0.17, noise)
+    numbers = draw_delay(figure, delay=0.17, noise=noise)
+    _check_figure(figure, numbers, 0.17, noise)
     # Default noise is the scenario's fixed draw.
-    draw_delay(figure, delay=0.17)
-    _check_figure(figure, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
+    numbers = draw_delay(figure, delay=0.17)
+    _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
 
 
 def test_draw_function_clears_a_foreign_figure():
     figure = Figure()
     figure.subplots(1, 3)
-    draw_delay(figure, delay=0.1)
+    numbers = draw_delay(figure, delay=0.1)
     assert len(figure.axes) == 2
-    _check_figure(figure, 0.1, DEFAULT.unit_noise(sensors=("vision",)))
+    _check_figure(figure, numbers, 0.1, DEFAULT.unit_noise(sensors=("vision",)))
 
 
 def test_explorer_follows_its_scenario():
@@ -179,7 +205,7 @@ def test_explorer_follows_its_scenario():
     explorer = explore_delay(scenario)
     assert explorer.sliders["delay"].value == pytest.approx(0.2)
     noise = scenario.unit_noise(sensors=("vision",))
-    _check_figure(explorer.figure, 0.2, noise, sigma_v=4.5)
+    _check_figure(explorer.figure, explorer.numbers, 0.2, noise, sigma_v=4.5)
 
 
 def test_slider_range_stops_before_the_end_of_a_short_trial():

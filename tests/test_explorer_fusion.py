@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 
 import numpy as np
 import pytest
 from explorer_checks import fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from lqe_helpers.explorers.fusion import (
     FUSED,
+    SHARES_TITLE,
     SIGMA_RANGE,
     draw_fusion,
     explore_fusion,
@@ -58,8 +61,9 @@ def _independent(sigma_v: float, sigma_p: float, noise: np.ndarray,
     }
 
 
-def _check_figure(figure: Figure, sigma_v: float, sigma_p: float, noise: np.ndarray,
-                  scenario: Scenario = DEFAULT) -> None:
+def _check_figure(figure: Figure, numbers: str, sigma_v: float, sigma_p: float,
+                  noise: np.ndarray, scenario: Scenario = DEFAULT) -> None:
+    """``figure`` and the ``numbers`` its drawing returned show this trial, computed anew."""
     expected = _independent(sigma_v, sigma_p, noise, scenario)
     lines = _lines(figure, scenario)
     assert set(lines) == LINE_GIDS
@@ -72,13 +76,16 @@ def _check_figure(figure: Figure, sigma_v: float, sigma_p: float, noise: np.ndar
     assert weights["weight proprioception"] == pytest.approx(1 - share_v, rel=1e-9)
     texts = [text.get_text() for ax in figure.axes for text in ax.texts]
     assert texts == [f"{100 * share_v:.0f} %", f"{100 * (1 - share_v):.0f} %"]
-    # The title carries both σ's and this trial's MSEs after the burn-in.
+    # The numbers beside the figure carry both σ's and this trial's MSEs after the
+    # burn-in; the figure has no title of its own and the right panel's never changes.
     skip = scenario.burn_in_steps
-    title = figure.get_suptitle()
-    assert f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm" in title
-    for name, gid in (("vision only", "vision-only error"), ("fused", "fused error")):
-        mse = np.mean(expected[gid][skip:] ** 2)
-        assert f"{name} {mse:.3f} cm²" in title, (name, title)
+    mse_vision, mse_fused = (np.mean(expected[gid][skip:] ** 2)
+                             for gid in ("vision-only error", "fused error"))
+    assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
+                       f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
+                       f"fused {mse_fused:.3f} cm²."), numbers
+    assert figure.get_suptitle() == ""
+    assert figure.axes[2].get_title() == SHARES_TITLE
 
 
 def test_slider_conventions():
@@ -100,7 +107,7 @@ def test_slider_conventions():
 
 def test_initial_figure_is_question_c():
     explorer = explore_fusion()
-    _check_figure(explorer.figure, 1.5, 1.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, 1.5, 1.5, DEFAULT.unit_noise(sensors=FUSED))
     assert explorer.png.startswith(b"\x89PNG")
 
 
@@ -110,7 +117,8 @@ def test_slider_values_redraw_the_direct_computation(sigma_v, sigma_p):
     before = explorer.png
     explorer.sliders["sigma_v"].value = sigma_v
     explorer.sliders["sigma_p"].value = sigma_p
-    _check_figure(explorer.figure, sigma_v, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, sigma_v, sigma_p,
+                  DEFAULT.unit_noise(sensors=FUSED))
     assert explorer.png != before
 
 
@@ -148,12 +156,43 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     bands = [c for c in axes[1].collections if c.get_gid() == "fused band"]
     assert len(bands) == 1
     fresh = fresh_figure()
-    draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5)
+    numbers = draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5)
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     for gid in LINE_GIDS:
         np.testing.assert_array_equal(reused[gid], drawn[gid], err_msg=gid)
     assert _weights(explorer.figure) == _weights(fresh)
-    assert explorer.figure.get_suptitle() == fresh.get_suptitle()
+    assert explorer.numbers == numbers
+
+
+def _texts(figure: Figure) -> list[str]:
+    return [text.get_text() for text in figure.findobj(Text)]
+
+
+def test_only_the_shares_on_the_bars_change_among_the_figures_texts():
+    """Text is the costliest artist to repaint: the numbers live beside the figure."""
+    explorer = explore_fusion()
+    before, numbers = _texts(explorer.figure), explorer.numbers
+    explorer.sliders["sigma_v"].value = 3.0
+    explorer.sliders["sigma_p"].value = 0.75
+    share_v = 0.75**2 / (3.0**2 + 0.75**2)
+    changed = [(old, new) for old, new in zip(before, _texts(explorer.figure), strict=True)
+               if old != new]
+    assert changed == [("50 %", f"{100 * share_v:.0f} %"),
+                       ("50 %", f"{100 * (1 - share_v):.0f} %")]
+    assert explorer.numbers != numbers
+
+
+def test_the_right_panels_title_stays_in_the_cached_background():
+    """Clear of the bars' axes area, so a move repaints the bars but not the title."""
+    explorer = explore_fusion()
+    title = explorer.figure.axes[2].title
+    for sigma_v, sigma_p in ((0.5, 6.0), (6.0, 0.5), (0.75, 6.0), (0.5, 5.75)):
+        explorer.sliders["sigma_v"].value = sigma_v
+        explorer.sliders["sigma_p"].value = sigma_p
+    assert explorer.layers.fast_renders >= 1
+    repainted = explorer.layers._background.redrawn  # the artists a move repaints
+    assert any(patch.get_gid() == "weight vision" for patch in repainted)
+    assert title not in repainted
 
 
 def test_band_is_the_fused_filters_own_two_standard_deviations():
@@ -182,25 +221,26 @@ def _upper_edge(vertices: np.ndarray) -> np.ndarray:
 def test_draw_function_on_a_fresh_figure_with_given_noise():
     figure = fresh_figure()
     noise = np.random.default_rng(7).standard_normal((DEFAULT.n_steps, 2))
-    draw_fusion(figure, sigma_v=2.5, sigma_p=1.0, noise=noise)
-    _check_figure(figure, 2.5, 1.0, noise)
-    draw_fusion(figure, sigma_v=2.5, sigma_p=1.0)
-    _check_figure(figure, 2.5, 1.0, DEFAULT.unit_noise(sensors=FUSED))
+    numbers = draw_fusion(figure, sigma_v=2.5, sigma_p=1.0, noise=noise)
+    _check_figure(figure, numbers, 2.5, 1.0, noise)
+    numbers = draw_fusion(figure, sigma_v=2.5, sigma_p=1.0)
+    _check_figure(figure, numbers, 2.5, 1.0, DEFAULT.unit_noise(sensors=FUSED))
 
 
 def test_draw_function_clears_a_foreign_figure():
     figure = fresh_figure()
     figure.subplots(2, 2)
-    draw_fusion(figure, sigma_v=1.5, sigma_p=4.5)
+    numbers = draw_fusion(figure, sigma_v=1.5, sigma_p=4.5)
     assert len(figure.axes) == 3
-    _check_figure(figure, 1.5, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(figure, numbers, 1.5, 4.5, DEFAULT.unit_noise(sensors=FUSED))
 
 
 def test_explorer_follows_its_scenario():
     scenario = dataclasses.replace(DEFAULT, sigma_v=2.0, sigma_p=3.0, seed=11)
     explorer = explore_fusion(scenario)
     assert explorer.values == pytest.approx({"sigma_v": 2.0, "sigma_p": 3.0})
-    _check_figure(explorer.figure, 2.0, 3.0, scenario.unit_noise(sensors=FUSED), scenario)
+    _check_figure(explorer.figure, explorer.numbers, 2.0, 3.0,
+                  scenario.unit_noise(sensors=FUSED), scenario)
 
 
 @pytest.mark.parametrize(("sigma_v", "sigma_p", "name"),
@@ -242,6 +282,9 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
     for description in ("σ_v (cm)", "σ_p (cm)"):
         assert description in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+    # A reader of the static page gets the trial's MSEs too, in the caption.
+    assert explorer.numbers.startswith("σ_v = 1.5 cm, σ_p = 1.5 cm. MSE of this trial")
+    assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
 @pytest.mark.parametrize(("field", "value"), [("sigma_v", 0.25), ("sigma_p", 7.0)])

@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 
 import numpy as np
 import pytest
 from explorer_checks import band_matches, line, png
+from matplotlib.axis import Tick
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.text import Text
 
 from lqe_helpers import experiments, metrics
 from lqe_helpers.explorers import initial_covariance as ic
@@ -59,12 +63,31 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance)
         band_matches(ax, ic.BAND_LABEL, estimates[:, column] - 2 * std,
                      estimates[:, column] + 2 * std)
 
-    title = explorer.figure.get_suptitle()
+    # The numbers go to the line beside the figure, not into it.
     burn = DEFAULT.burn_in_steps
     early = metrics.mse(expected.positions[:burn], truth[:burn, 0])
-    assert f"P0 = {p0_variance:.3g}" in title
-    assert f"{early:.2f} cm² in the first" in title
-    assert f"{float(expected.mse()):.2f} cm² after" in title
+    late = metrics.mse(expected.positions, truth[:, 0], burn)
+    assert explorer.numbers == (f"P0 = {p0_variance:.3g} · I. Position MSE of this run: "
+                                f"{early:.2f} cm² in the first {DEFAULT.burn_in:g} s, "
+                                f"{late:.2f} cm² after.")
+    assert explorer.figure.get_suptitle() == ""
+
+
+def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
+    """Text is the costliest artist to repaint: the numbers live beside the figure."""
+
+    def texts() -> list[str]:  # tick labels follow the axis limits: left out
+        ticks = {label for tick in explorer.figure.findobj(Tick)
+                 for label in (tick.label1, tick.label2)}
+        return [text.get_text() for text in explorer.figure.findobj(Text) if text not in ticks]
+
+    before, numbers = texts(), explorer.numbers
+    explorer.sliders["p0_variance"].value = 1e6
+    assert texts() == before
+    assert explorer.numbers != numbers
+    # Nor is any text (titles, legends, labels) painted again over the moving data.
+    repainted = explorer.layers._background.redrawn
+    assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]
 
 
 def test_first_step_follows_tutorial_gain_formula(explorer) -> None:
@@ -124,6 +147,8 @@ def test_static_display_carries_the_picture(explorer) -> None:
     bundle = explorer._repr_mimebundle_()
     assert "P0 (cm²)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+    assert explorer.numbers.startswith(f"P0 = {DEFAULT.p0_variance:.3g} · I. ")
+    assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
@@ -143,9 +168,9 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     assert len(figure.axes) == 2
     assert "someone else's line" not in [a.get_label() for a in figure.axes[0].get_lines()]
     figure.clear()
-    ic.draw_initial_covariance(figure, p0_variance=1e3)
+    numbers = ic.draw_initial_covariance(figure, p0_variance=1e3)
     assert len(figure.axes) == 2
-    assert figure.get_suptitle().startswith("P0 = 1e+03")
+    assert numbers.startswith("P0 = 1e+03 · I. ")
 
 
 def test_slider_starts_at_the_scenarios_p0_variance() -> None:

@@ -3,18 +3,21 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 
 import numpy as np
 import pytest
 from explorer_checks import fresh_figure
 from explorer_checks import lines_by_gid as _lines
 from matplotlib.figure import Figure
+from matplotlib.text import Text
 
 from lqe_helpers.explorers.noisier_proprioception import (
     CURVE_RANGE,
     FUSED,
     QUESTION_SIGMA_P,
     SIGMA_P_RANGE,
+    THEORY_TITLE,
     draw_noisier_proprioception,
     explore_noisier_proprioception,
     steady_position_variances,
@@ -34,8 +37,9 @@ def _filter(readings: np.ndarray, sigmas: list[float], scenario: Scenario):
                          np.asarray(scenario.z0, float), scenario.p0_variance * np.eye(3))
 
 
-def _check_figure(figure: Figure, sigma_p: float, noise: np.ndarray,
+def _check_figure(figure: Figure, numbers: str, sigma_p: float, noise: np.ndarray,
                   scenario: Scenario = DEFAULT) -> None:
+    """``figure`` and the ``numbers`` its drawing returned show this trial, computed anew."""
     sigma_v = scenario.sigma_v
     truth = scenario.truth[:, 0]
     readings = truth[:, None] + noise * [sigma_v, sigma_p]
@@ -54,16 +58,19 @@ def _check_figure(figure: Figure, sigma_p: float, noise: np.ndarray,
     x, y = lines["theory now"]
     assert x == pytest.approx([sigma_p])
     assert y == pytest.approx([fused.estimate_covariances[-1, 0, 0]], rel=1e-7)
-    # Proprioception's weight is its share of the reliabilities 1/σ².
+    # The numbers beside the figure carry both σ's, this trial's MSEs after the burn-in
+    # and proprioception's weight, its share of the reliabilities 1/σ²; the figure has
+    # no title of its own and the right panel's never changes.
     weight = sigma_v**2 / (sigma_v**2 + sigma_p**2)
-    theory_ax = figure.axes[2]
-    assert f"proprioception's weight: {100 * weight:.1f} %" in theory_ax.get_title()
     skip = scenario.burn_in_steps
-    title = figure.get_suptitle()
-    assert f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm" in title
-    for name, estimate in (("vision only", alone), ("fused", both)):
-        mse = np.mean((estimate[skip:] - truth[skip:]) ** 2)
-        assert f"{name} {mse:.3f} cm²" in title, (name, title)
+    mse_vision, mse_fused = (np.mean((estimate[skip:] - truth[skip:]) ** 2)
+                             for estimate in (alone, both))
+    assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
+                       f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
+                       f"fused {mse_fused:.3f} cm². Proprioception's weight in the steady "
+                       f"state: {100 * weight:.1f} %."), numbers
+    assert figure.get_suptitle() == ""
+    assert figure.axes[2].get_title() == THEORY_TITLE
 
 
 def test_slider_conventions():
@@ -84,7 +91,7 @@ def test_slider_conventions():
 
 def test_initial_figure_is_question_d():
     explorer = explore_noisier_proprioception()
-    _check_figure(explorer.figure, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, 4.5, DEFAULT.unit_noise(sensors=FUSED))
     assert explorer.png.startswith(b"\x89PNG")
 
 
@@ -93,7 +100,7 @@ def test_slider_value_redraws_the_direct_computation(sigma_p):
     explorer = explore_noisier_proprioception()
     before = explorer.png
     explorer.sliders["sigma_p"].value = sigma_p
-    _check_figure(explorer.figure, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
     assert explorer.png != before
 
 
@@ -149,35 +156,48 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     assert explorer.figure.axes == axes
     assert len(axes) == 3
     fresh = fresh_figure()
-    draw_noisier_proprioception(fresh, sigma_p=7.5)
+    numbers = draw_noisier_proprioception(fresh, sigma_p=7.5)
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     assert set(reused) == set(drawn)
     for gid in drawn:
         for a, b in zip(reused[gid], drawn[gid], strict=True):
             np.testing.assert_array_equal(a, b, err_msg=gid)
-    assert explorer.figure.get_suptitle() == fresh.get_suptitle()
-    assert axes[2].get_title() == fresh.axes[2].get_title()
+    assert explorer.numbers == numbers
+
+
+def test_no_text_in_the_figure_changes_with_the_slider():
+    """Text is the costliest artist to repaint: the numbers live beside the figure."""
+    explorer = explore_noisier_proprioception()
+
+    def texts() -> list[str]:
+        return [text.get_text() for text in explorer.figure.findobj(Text)]
+
+    before, numbers = texts(), explorer.numbers
+    explorer.sliders["sigma_p"].value = 12.0
+    assert texts() == before
+    assert explorer.numbers != numbers
 
 
 def test_draw_function_on_a_fresh_figure_with_given_noise():
     figure = fresh_figure()
     noise = np.random.default_rng(3).standard_normal((DEFAULT.n_steps, 2))
-    draw_noisier_proprioception(figure, sigma_p=2.5, noise=noise)
-    _check_figure(figure, 2.5, noise)
+    numbers = draw_noisier_proprioception(figure, sigma_p=2.5, noise=noise)
+    _check_figure(figure, numbers, 2.5, noise)
 
 
 def test_draw_function_clears_a_foreign_figure():
     figure = fresh_figure()
     figure.subplots(1, 4)
-    draw_noisier_proprioception(figure, sigma_p=4.5)
+    numbers = draw_noisier_proprioception(figure, sigma_p=4.5)
     assert len(figure.axes) == 3
-    _check_figure(figure, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(figure, numbers, 4.5, DEFAULT.unit_noise(sensors=FUSED))
 
 
 def test_explorer_follows_its_scenario():
     scenario = dataclasses.replace(DEFAULT, sigma_v=3.0, seed=2)
     explorer = explore_noisier_proprioception(scenario)
-    _check_figure(explorer.figure, 4.5, scenario.unit_noise(sensors=FUSED), scenario)
+    _check_figure(explorer.figure, explorer.numbers, 4.5, scenario.unit_noise(sensors=FUSED),
+                  scenario)
 
 
 @pytest.mark.parametrize("sigma_p", [0.0, -4.5, float("inf")])
@@ -202,15 +222,18 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
     for description in ("σ_p (cm)",):
         assert description in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+    # A reader of the static page gets the trial's MSEs and the weight too, in the caption.
+    assert explorer.numbers.startswith("σ_v = 1.5 cm, σ_p = 4.5 cm. MSE of this trial")
+    assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
 def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
     figure = fresh_figure()
-    draw_noisier_proprioception(figure, sigma_p=30.0)
+    numbers = draw_noisier_proprioception(figure, sigma_p=30.0)
     theory_ax = figure.axes[2]
     figure.canvas.draw()
     labels = [label.get_text() for label in theory_ax.get_xticklabels()]
     assert labels == ["0.3", "1", "3", "10", "30", "100"]
     assert theory_ax.get_xticklabels(minor=True) == []
     # At σ_p = 30 cm proprioception still has a weight: 2.25 / (2.25 + 900) ≈ 0.25 %.
-    assert theory_ax.get_title().endswith("proprioception's weight: 0.2 %")
+    assert numbers.endswith("Proprioception's weight in the steady state: 0.2 %.")

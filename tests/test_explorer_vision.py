@@ -3,11 +3,15 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 
 import numpy as np
 import pytest
 from explorer_checks import band_matches, line, png
+from matplotlib.axis import Tick
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.text import Text
 
 from lqe_helpers import experiments, metrics
 from lqe_helpers.explorers import vision
@@ -51,13 +55,32 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: flo
     std = np.sqrt(expected.position_variances)
     band_matches(ax, vision.BAND_LABEL, expected.positions - 2 * std,
                  expected.positions + 2 * std)
-    title = ax.get_title()
-    assert f"σ_v = {sigma_v:.1f} cm" in title
+    # The numbers go to the line beside the figure, not into it.
     raw = metrics.mse(truth + sigma_v * noise[:, 0], truth, DEFAULT.burn_in_steps)
-    assert f"raw vision {raw:.2f} cm²" in title
-    assert f"filtered {float(expected.mse()):.2f} cm²" in title
+    filtered = np.mean((expected.positions - truth)[DEFAULT.burn_in_steps:] ** 2)
+    assert explorer.numbers == (f"σ_v = {sigma_v:.1f} cm. MSE of this run after "
+                                f"{DEFAULT.burn_in:g} s: raw vision {raw:.2f} cm², "
+                                f"filtered {filtered:.2f} cm².")
+    assert ax.get_title() == ""
     if sigma_v != DEFAULT.sigma_v:
         assert explorer.png != previous_png
+
+
+def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
+    """Text is the costliest artist to repaint: the numbers live beside the figure."""
+
+    def texts() -> list[str]:  # tick labels follow the axis limits: left out
+        ticks = {label for tick in explorer.figure.findobj(Tick)
+                 for label in (tick.label1, tick.label2)}
+        return [text.get_text() for text in explorer.figure.findobj(Text) if text not in ticks]
+
+    before, numbers = texts(), explorer.numbers
+    explorer.sliders["sigma_v"].value = 7.3
+    assert texts() == before
+    assert explorer.numbers != numbers
+    # Nor is any text (titles, legends, labels) painted again over the moving data.
+    repainted = explorer.layers._background.redrawn
+    assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]
 
 
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
@@ -74,7 +97,7 @@ def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
 def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
     figure = Figure()
     noise = np.zeros((DEFAULT.n_steps, 1))
-    vision.draw_vision(figure, sigma_v=2.0, noise=noise)
+    numbers = vision.draw_vision(figure, sigma_v=2.0, noise=noise)
     (ax,) = figure.axes
     truth = DEFAULT.truth[:, 0]
     # Zero noise: vision sees the truth, and the filter's only error is its lag.
@@ -82,7 +105,7 @@ def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
     expected = experiments.track(DEFAULT, sigmas=[2.0], noise=noise)
     np.testing.assert_allclose(line(ax, vision.ESTIMATE_LABEL), expected.positions,
                                rtol=0, atol=1e-12)
-    assert "raw vision 0.00 cm²" in ax.get_title()
+    assert f"raw vision 0.00 cm², filtered {float(expected.mse()):.2f} cm²." in numbers
     # Drawing again replaces, not adds.
     vision.draw_vision(figure, sigma_v=3.0, noise=noise)
     assert len(figure.axes) == 1
@@ -117,6 +140,8 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_v (cm)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
+    assert explorer.numbers.startswith(f"σ_v = {DEFAULT.sigma_v:.1f} cm. ")
+    assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
 def test_slider_starts_at_the_scenarios_sigma_v() -> None:
@@ -149,7 +174,7 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     (ax,) = figure.axes
     assert "someone else's line" not in [artist.get_label() for artist in ax.get_lines()]
     figure.clear()
-    vision.draw_vision(figure, sigma_v=2.0)
+    numbers = vision.draw_vision(figure, sigma_v=2.0)
     (ax,) = figure.axes
-    assert "σ_v = 2.0 cm" in ax.get_title()
+    assert numbers.startswith("σ_v = 2.0 cm. ")
     assert len(ax.get_lines()) == 3

@@ -3,8 +3,10 @@
 Both :mod:`lqe_helpers.explorers.fusion` and
 :mod:`lqe_helpers.explorers.noisier_proprioception` show one trial of a vision-only
 and a fused filter in a left column (signals over errors) beside a side panel of
-their own, with a legend above and the trial's MSEs in the title. This module holds
-that common part; each explorer fills its side panel.
+their own, with a legend above. The trial's MSEs are not drawn in the figure: the
+drawing function returns them as text (:func:`trial_numbers`), which the explorer
+shows between its sliders and the picture. This module holds that common part; each
+explorer fills its side panel.
 """
 
 from __future__ import annotations
@@ -88,12 +90,15 @@ def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,
     }
 
 
-def set_trial_title(figure: Figure, scenario: Scenario, sigma_v: float, sigma_p: float,
-                    vision: experiments.Tracking, fused: experiments.Tracking) -> None:
-    """Title ``figure`` with both σ's and the trial's MSEs after the burn-in."""
-    figure.suptitle(
-        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm.   MSE of this trial after "
+def trial_numbers(scenario: Scenario, sigma_v: float, sigma_p: float,
+                  vision: experiments.Tracking, fused: experiments.Tracking) -> str:
+    """Both σ's (cm) and the trial's MSEs (cm²) after the burn-in, as one sentence.
+
+    E.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE of this trial after 1 s: vision only
+    0.304 cm², fused 0.274 cm²."
+    """
+    return (
+        f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
         f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
-        f"fused {float(fused.mse()):.3f} cm²",
-        x=0.07, y=0.985, ha="left", fontsize=10,
+        f"fused {float(fused.mse()):.3f} cm²."
     )

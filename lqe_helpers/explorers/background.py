@@ -3,10 +3,14 @@
 Left panel: how fast the position uncertainty grows once the measurements stop
 (Lesson 0.5 eq. (9) with no correction). Right panel: one tracking run at the same
 σ_j, to see the trade-off between lag (σ_j too small) and noise (σ_j too large).
+The numbers of the view (σ_j, when the uncertainty reaches the flight's amplitude,
+this run's MSE and the variance the filter expects) are returned as one line of
+text that the explorer shows between the slider and the figure.
 
 Speed: building the axes, ticks and legends costs more than the filter run, so
 :func:`draw_background` builds the panels once per figure and afterwards only
-replaces the data and titles of the same artists.
+replaces the data of the same artists; the panels' titles never change, and the
+numbers stay out of the figure, where text would be rendered again on every move.
 """
 
 from __future__ import annotations
@@ -35,6 +39,13 @@ TRACKING_WINDOW = (1.0, 5.0)
 #: Slider range of σ_j (cm/s³): two decades either side of the matched ≈ 1 400 cm/s³.
 JERK_STD_RANGE = (10.0, 1.0e5)
 
+#: Titles of the two panels; they never change (the numbers go beside the figure).
+GROWTH_TITLE = "Uncertainty once the measurements stop"
+TRACKING_TITLE = "Tracking"
+#: Gap (points) between a panel and its title: wide enough that the title is not
+#: painted again with the top spine, which every move repaints over the curves.
+TITLE_PAD = 10.0
+
 #: Labels of the plotted artists, so tests and readers can find them.
 GROWTH_LABEL = "2σ at this σ_j"
 REFERENCE_LABEL = "2σ at the scenario's σ_j"
@@ -61,8 +72,11 @@ def format_jerk(jerk_std: float) -> str:
 
 
 def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
+    """When 2σ of ``loop``'s position first reaches ``amplitude`` (cm), as text."""
     crossing = amplitude_crossing(loop, amplitude)
-    return f"after {crossing:.2f} s" if crossing is not None else f"after > {loop.times[-1]:g} s"
+    if crossing is None:
+        return f"after more than {loop.times[-1]:g} s"
+    return f"after {crossing:.2f} s"
 
 
 class _Panels(NamedTuple):
@@ -95,6 +109,7 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
     growth_ax.set_xlabel("time since the last measurement (s)")
     growth_ax.set_ylabel("2σ of predicted position (cm)")
+    growth_ax.set_title(GROWTH_TITLE, fontsize=10, pad=TITLE_PAD)
     # Legends below the panels, never over a moving curve: a legend a curve passes
     # under has to be painted again on every slider move.
     growth_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=2)
@@ -109,20 +124,20 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     track_ax.set_xlim(*TRACKING_WINDOW)
     track_ax.xaxis.set_major_locator(MultipleLocator(1.0))  # fewer labels: faster redraws
     label_time_position(track_ax)
+    track_ax.set_title(TRACKING_TITLE, fontsize=10, pad=TITLE_PAD)
     track_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=3)
     figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.25, wspace=0.22)
     return _Panels((growth_ax, track_ax), growth, vision, estimate)
 
 
 def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEFAULT,
-                    noise: np.ndarray | None = None) -> None:
+                    noise: np.ndarray | None = None) -> str:
     """Draw open-loop growth and tracking for the jerk noise ``jerk_std`` (cm/s³).
 
     Left: twice the standard deviation of the predicted position when the
     measurements stop after the filter has settled (Lesson 0.5 eq. (9)), at
     ``jerk_std`` and at the scenario's own σ_j, against the flight's amplitude.
-    Right: one vision-only tracking run with Q built from ``jerk_std``; the title
-    gives this run's MSE after the burn-in and the variance the filter expects.
+    Right: one vision-only tracking run with Q built from ``jerk_std``.
 
     A figure not drawn by this function is cleared first; on one it drew before,
     for the same scenario, the same artists receive the new data (rebuilding the
@@ -139,6 +154,13 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     noise : array_like, shape (n, 1), optional
         Vision's unit noise; default the scenario's fixed draw.
 
+    Returns
+    -------
+    str
+        The numbers of this view, for the line beside the figure: σ_j, when 2σ of
+        the predicted position first reaches the amplitude, and this run's position
+        MSE after the burn-in (cm²) with the error variance the filter expects there.
+
     Raises
     ------
     ValueError
@@ -154,15 +176,14 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     expected = float(np.mean(tracking.position_variances[scenario.burn_in_steps:]))
 
     panels = reuse_panels(figure, _build, scenario)
-    growth_ax, track_ax = panels.axes
     panels.growth.set_ydata(2 * growth.position_stds)
-    growth_ax.set_title(f"σ_j = {format_jerk(jerk_std)} cm/s³: 2σ reaches "
-                        f"{scenario.amplitude:g} cm {_crossing_text(growth, scenario.amplitude)}",
-                        fontsize=10)
     panels.vision.set_ydata(tracking.measurements[window, 0])
     panels.estimate.set_ydata(tracking.positions[window])
-    track_ax.set_title(f"Tracking: MSE {float(tracking.mse()):.3g} cm², "
-                       f"filter expects {expected:.3g} cm²", fontsize=10)
+    return (f"σ_j = {format_jerk(jerk_std)} cm/s³. Without measurements, 2σ of the predicted "
+            f"position reaches the flight's amplitude of {scenario.amplitude:g} cm "
+            f"{_crossing_text(growth, scenario.amplitude)}. Tracking MSE of this run after "
+            f"{scenario.burn_in:g} s: {float(tracking.mse()):.3g} cm², the filter expects "
+            f"{expected:.3g} cm².")
 
 
 def describe_background(*, jerk_std: float, scenario: Scenario = DEFAULT) -> str:

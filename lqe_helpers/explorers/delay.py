@@ -4,7 +4,9 @@ One slider sets the visual delay d. The figure shows, on the wall-clock time axi
 what the observer has at each moment: the delayed noisy readings ``y_{j−δ}``, the
 filter's newest (delayed) estimate ``ẑ_{j−δ}`` and the compensated prediction
 ``z*_j = A^δ ẑ_{j−δ}`` (Tutorial eqs. (7)–(8)), next to the true path, with the
-errors of both estimates in a panel below.
+errors of both estimates in a panel below. The numbers of the view (d, δ and this
+run's MSEs) are not drawn in the figure: the drawing function returns them as one
+line of text, which the explorer shows between the slider and the picture.
 """
 
 from __future__ import annotations
@@ -28,7 +30,7 @@ from ..scenario import DEFAULT, Scenario
 #: the point where prediction stops paying off.
 MAX_DELAY = 0.5
 #: Seconds of the trial shown (s): the start, where nothing has arrived yet, and two
-#: periods of steady tracking. The MSEs in the title cover the whole trial after burn-in.
+#: periods of steady tracking. The MSEs returned cover the whole trial after burn-in.
 WINDOW = 4.0
 
 #: The question's sensor: vision alone.
@@ -59,15 +61,18 @@ class _Panels(NamedTuple):
 
 
 def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
-               noise: np.ndarray | None = None) -> None:
+               noise: np.ndarray | None = None) -> str:
     """Draw one run of the delayed, compensated vision-only filter on ``figure``.
 
     The top axes show the true position, the delayed visual readings, the delayed
     estimate and the compensated prediction over the first :data:`WINDOW` s; a grey
     band covers the first d seconds, when nothing has arrived yet. The bottom axes
-    show both estimates' errors (estimate − truth). The title gives this run's MSEs
-    (cm², over the whole trial after the burn-in or the delay, whichever is longer)
-    with and without compensation, and of the same filter with no delay.
+    show both estimates' errors (estimate − truth). Returns the delay and this run's
+    MSEs (cm², over the whole trial after the burn-in or the delay, whichever is
+    longer) with and without compensation, and of the same filter with no delay, as
+    one line of text (the explorer shows it beside the figure), e.g. "Delay
+    d = 0.10 s (δ = 10 steps). MSE of this run: delayed 4.99 cm², compensated
+    1.92 cm², no delay 0.30 cm²."
 
     A figure already drawn by this function for the same scenario keeps its axes and
     only has its data replaced (redrawing axes from scratch costs more than the
@@ -84,6 +89,11 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
     noise : array_like, shape (n, 1), optional
         Unit noise of vision; default the scenario's fixed draw.
 
+    Returns
+    -------
+    str
+        d (s), δ (steps) and the three MSEs (cm²).
+
     Raises
     ------
     ValueError
@@ -92,10 +102,10 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
     scenario.delay_steps(delay)  # validate before any work
     if noise is None:
         noise = scenario.unit_noise(sensors=SENSORS)
-    _draw_tracking(figure, delay, experiments.track(scenario, SENSORS, noise=noise))
+    return _draw_tracking(figure, delay, experiments.track(scenario, SENSORS, noise=noise))
 
 
-def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking) -> None:
+def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking) -> str:
     """:func:`draw_delay` for a filter run already made (the delay only shifts it)."""
     scenario = tracking.scenario
     delayed = experiments.delay_and_compensate(tracking, delay)
@@ -135,18 +145,15 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
         # The same span every time, resized (a new one would force a full repaint).
         span.set_width(steps * scenario.dt)
         span.set_visible(steps > 0)
-    figure.suptitle(
-        f"delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps).   MSE of this run: "
-        f"delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
-        f"no delay {mse_now:.2f} cm²",
-        fontsize=9.5, y=0.985,
-    )
+    return (f"Delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps). MSE of this run: "
+            f"delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
+            f"no delay {mse_now:.2f} cm².")
 
 
 def _build(figure: Figure, scenario: Scenario) -> _Panels:
     """Build the two axes of :func:`draw_delay` on the empty ``figure``, lines empty."""
     axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
-    figure.subplots_adjust(top=0.865, bottom=0.1, hspace=0.12)
+    figure.subplots_adjust(top=0.91, bottom=0.1, hspace=0.12)
     lines = {}
     for gid, (index, role, label) in _LINES.items():
         kwargs = {"linewidth": 1.2} if index == 1 else {}
@@ -154,14 +161,18 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     handles = [lines[gid] for gid, (index, _, _) in _LINES.items() if index == 0]
     handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
                          label="nothing has arrived yet"))
-    figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.945), ncol=5,
+    figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.995), ncol=5,
                   fontsize=8, handlelength=2.2, columnspacing=1.2, markerscale=2.5)
     top, bottom = axes
     top.set_ylabel("position (cm)")
     bottom.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
-    # Below the lines (zorder 1.7): a fixed text under them stays in the cached layer.
+    # Under the band and the lines (above the grid's zorder 1.5): a fixed text painted
+    # before what a move changes stays in the cached layer; above the band it would be
+    # repainted with it on every move (the band's extent is its whole axes). The band
+    # reaches this corner only when the delay spans most of the window shown (a short
+    # trial); the text then shows through it.
     bottom.text(0.99, 0.95, "error = estimate − true position", transform=bottom.transAxes,
-                ha="right", va="top", fontsize=8, zorder=1.7)
+                ha="right", va="top", fontsize=8, zorder=(1.5 + DATA_UNDER_LINES) / 2)
     bottom.set_xlabel("time (s)")
     bottom.set_ylabel("error (cm)")
     bottom.set_xlim(0.0, min(WINDOW, scenario.duration))
@@ -213,7 +224,7 @@ def describe_delay(*, delay: float, scenario: Scenario = DEFAULT) -> str:
             f"prediction, with both estimates' errors below.")
 
 
-def _draw_on_grid(figure: Figure, *, delay: float, tracking: experiments.Tracking) -> None:
+def _draw_on_grid(figure: Figure, *, delay: float, tracking: experiments.Tracking) -> str:
     """Round the slider's float to the nearest whole step, then draw the fixed run."""
     dt = tracking.scenario.dt
-    _draw_tracking(figure, round(delay / dt) * dt, tracking)
+    return _draw_tracking(figure, round(delay / dt) * dt, tracking)

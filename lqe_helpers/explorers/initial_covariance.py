@@ -4,10 +4,13 @@ One logarithmic slider sets P0 = p0_variance · I. The figure shows the first
 seconds of one run: position (truth, noisy vision, estimate) and velocity (truth,
 estimate), each estimate with the ±2σ band of the filter's own variance, so the
 reader sees both how fast the wrong initial guess is corrected and how confident
-the filter is while it is still wrong.
+the filter is while it is still wrong. The numbers of the view (P0 and this run's
+position MSEs) are returned as one line of text that the explorer shows between the
+slider and the figure.
 
 Speed: as in :mod:`lqe_helpers.explorers.vision`, the panels are built once per
-figure and later calls replace the data, limits and title of the same artists; the
+figure and later calls replace the data and limits of the same artists; the numbers
+stay out of the figure, where text would be rendered again on every move. The
 picture equals a fresh drawing.
 """
 
@@ -21,7 +24,6 @@ from matplotlib.axes import Axes
 from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
-from matplotlib.text import Text
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
@@ -64,7 +66,6 @@ class _Panels(NamedTuple):
     vision: Line2D
     bands: tuple[FillBetweenPolyCollection, FillBetweenPolyCollection]
     estimates: tuple[Line2D, Line2D]
-    title: Text
 
 
 def _build(figure: Figure, scenario: Scenario) -> _Panels:
@@ -90,14 +91,13 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     velocity_ax.set_ylim(-2.0 * speed, 2.0 * speed)
     figure.legend(*position_ax.get_legend_handles_labels(), loc="lower center", ncol=4,
                   fontsize=9, markerscale=3)
-    title = figure.suptitle("", fontsize=10)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.91, bottom=0.25, wspace=0.22)
-    return _Panels((position_ax, velocity_ax), vision, tuple(bands), tuple(estimates), title)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.97, bottom=0.25, wspace=0.22)
+    return _Panels((position_ax, velocity_ax), vision, tuple(bands), tuple(estimates))
 
 
 def draw_initial_covariance(figure: Figure, *, p0_variance: float,
                             scenario: Scenario = DEFAULT,
-                            noise: np.ndarray | None = None) -> None:
+                            noise: np.ndarray | None = None) -> str:
     """Draw the first :data:`WINDOW` seconds of one vision-only run with P0 = p0_variance · I.
 
     Draws the whole figure, two panels side by side. Left: true position, noisy
@@ -105,9 +105,8 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     estimate carries a band of ±2 standard deviations of the filter's own variance
     (Tutorial eq. (5)). The velocity axis is fixed to twice the butterfly's top
     speed, so a huge initial band or an overshooting estimate runs off the panel
-    instead of rescaling it. The title gives P0 and this run's position MSE before
-    and after the scenario's burn-in. A figure not drawn by this function is
-    cleared first; on one it drew before, the same artists receive the new data.
+    instead of rescaling it. A figure not drawn by this function is cleared first;
+    on one it drew before, the same artists receive the new data.
 
     Parameters
     ----------
@@ -120,6 +119,12 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
         Every other constant; vision noise is ``scenario.sigma_v``.
     noise : ndarray, shape (n, 1), optional
         Unit vision noise; default the scenario's fixed draw.
+
+    Returns
+    -------
+    str
+        The numbers of this view, for the line beside the figure: P0 and this
+        run's position MSE (cm²) before and after the scenario's burn-in.
 
     Raises
     ------
@@ -148,10 +153,8 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panels.axes[0], low - margin, high + margin, scenario.amplitude / 2)
-    panels.title.set_text(
-        f"P0 = {p0_variance:.3g} · I: position MSE of this run {early_mse:.2f} cm² in the "
-        f"first {scenario.burn_in:g} s, {late_mse:.2f} cm² after"
-    )
+    return (f"P0 = {p0_variance:.3g} · I. Position MSE of this run: {early_mse:.2f} cm² in "
+            f"the first {scenario.burn_in:g} s, {late_mse:.2f} cm² after.")
 
 
 def describe_initial_covariance(*, p0_variance: float, scenario: Scenario = DEFAULT) -> str:

@@ -2,13 +2,16 @@
 
 One slider sets the vision noise σ_v. The figure shows the true path, the noisy
 visual samples and the filter's estimate with the ±2σ band of its own position
-variance, for one fixed noise pattern scaled by σ_v.
+variance, for one fixed noise pattern scaled by σ_v. The numbers of the view (σ_v
+and this run's MSEs) are returned as one line of text that the explorer shows
+between the slider and the figure.
 
 Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
 filter run, so :func:`draw_vision` builds the panel once per figure
-(:func:`~lqe_helpers.explorer.reuse_panels`) and afterwards only replaces the data,
-limits and title of the same artists. The picture is the same as a fresh drawing (a
-test checks the PNG bytes); only the redraw is faster.
+(:func:`~lqe_helpers.explorer.reuse_panels`) and afterwards only replaces the data
+and limits of the same artists; the numbers stay out of the figure, where text would
+be rendered again on every move. The picture is the same as a fresh drawing (a test
+checks the PNG bytes); only the redraw is faster.
 """
 
 from __future__ import annotations
@@ -68,20 +71,19 @@ def _build(figure: Figure, scenario: Scenario) -> _Panel:
     label_time_position(ax)
     ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4, fontsize=9,
               markerscale=3)
-    figure.subplots_adjust(left=0.08, right=0.98, top=0.91, bottom=0.27)
+    figure.subplots_adjust(left=0.08, right=0.98, top=0.97, bottom=0.27)
     return _Panel(ax, vision, band, estimate)
 
 
 def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
-                noise: np.ndarray | None = None) -> None:
+                noise: np.ndarray | None = None) -> str:
     """Draw one vision-only tracking run at vision noise ``sigma_v`` on ``figure``.
 
     Draws the whole figure: the true position, the noisy visual measurements
     (Tutorial eq. (3)), the filtered estimate (Tutorial eq. (5)) and a band of ±2
-    standard deviations of the filter's own position variance. The title gives σ_v
-    and this run's mean squared error of the raw and the filtered signal after the
-    scenario's burn-in. A figure not drawn by this function is cleared first; on
-    one it drew before, the same artists receive the new data.
+    standard deviations of the filter's own position variance. A figure not drawn
+    by this function is cleared first; on one it drew before, the same artists
+    receive the new data.
 
     Parameters
     ----------
@@ -94,6 +96,13 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
         Every other constant (Δt, the flight, Q, z0, P0, burn-in).
     noise : ndarray, shape (n, 1), optional
         Unit noise scaled by σ_v; default the scenario's fixed vision draw.
+
+    Returns
+    -------
+    str
+        The numbers of this view, for the line beside the figure: σ_v and this
+        run's mean squared error (cm²) of the raw vision and of the filtered
+        estimate after the scenario's burn-in.
 
     Raises
     ------
@@ -117,11 +126,8 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panel.ax, low - margin, high + margin, scenario.amplitude / 2)
-    panel.ax.set_title(
-        f"σ_v = {sigma_v:.1f} cm: MSE after {scenario.burn_in:g} s, this run: "
-        f"raw vision {raw_mse:.2f} cm², filtered {filtered_mse:.2f} cm²",
-        fontsize=10,
-    )
+    return (f"σ_v = {sigma_v:.1f} cm. MSE of this run after {scenario.burn_in:g} s: "
+            f"raw vision {raw_mse:.2f} cm², filtered {filtered_mse:.2f} cm².")
 
 
 def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT) -> str:

@@ -399,6 +399,10 @@ _IMAGE_REPLACED_JS = """
 ([img, old]) => img.src !== old && img.complete && img.naturalWidth > 0
 """
 
+_TEXT_IS_JS = """
+([element, expected]) => element.textContent.trim() === expected
+"""
+
 
 def notebook_panel(page: Page) -> Locator:
     """The (one) open notebook."""
@@ -474,11 +478,13 @@ def unexecuted_cells(page: Page, panel: Locator) -> list[str]:
 
 @dataclass
 class ExplorerView:
-    """One explorer on the page: its output area, sliders and image."""
+    """One explorer on the page: its output area, sliders, numbers line and image."""
 
     output: Locator
     image: Locator
     sliders: list[Locator]
+    #: The line between the sliders and the image with the numbers of the view.
+    numbers: Locator
 
 
 def explorers(panel: Locator) -> list[ExplorerView]:
@@ -493,6 +499,7 @@ def explorers(panel: Locator) -> list[ExplorerView]:
             output=output,
             image=output.locator("img.widget-image"),
             sliders=[sliders.nth(k) for k in range(sliders.count())],
+            numbers=output.locator(".widget-html .widget-html-content"),
         ))
     return views
 
@@ -528,6 +535,31 @@ def wait_for_new_image(image: Locator, before: dict[str, object], what: str,
     return image_state(image)
 
 
+def wait_for_other_text(element: Locator, before: str, what: str,
+                        timeout_ms: float = REDRAW_MS) -> str:
+    """Wait until ``element`` shows a non-empty text other than ``before``; return it."""
+    try:
+        element.page.wait_for_function(
+            "([e, old]) => e.textContent.trim() !== '' && e.textContent.trim() !== old",
+            arg=[element.element_handle(), before], timeout=timeout_ms)
+    except _playwright_timeout():
+        raise AssertionError(
+            f"{what} still shows {before!r} after {timeout_ms / 1000:.0f} s") from None
+    return element.text_content().strip()
+
+
+def wait_for_text(element: Locator, expected: str, what: str,
+                  timeout_ms: float = REDRAW_MS) -> None:
+    """Wait until ``element`` shows exactly ``expected``."""
+    try:
+        element.page.wait_for_function(_TEXT_IS_JS, arg=[element.element_handle(), expected],
+                                       timeout=timeout_ms)
+    except _playwright_timeout():
+        raise AssertionError(
+            f"{what} shows {element.text_content().strip()!r}, expected {expected!r}"
+        ) from None
+
+
 def readout(slider: Locator) -> Locator:
     return slider.locator(".widget-readout")
 
@@ -557,17 +589,18 @@ def exercise_slider(view: ExplorerView, slider: Locator, what: str,
     """Move ``slider`` three times and check the explorer redraws each time.
 
     1. Keyboard: End (Home if the slider sits at its end) on the handle: the readout
-       moves and the image shows a different picture.
+       moves, the image shows a different picture and the numbers line other numbers.
     2. Readout: type the starting value back and press Enter: a different picture
        again, and the readout shows that value.
-    3. Keyboard again, to the same end: the picture equals the one of step 1 (same
-       value, same picture: the redraw is deterministic and its noise fixed).
+    3. Keyboard again, to the same end: the picture and the numbers equal those of
+       step 1 (same value, same view: the redraw is deterministic and its noise fixed).
 
     Raises AssertionError naming ``what`` at the first step that fails.
     """
     slider.scroll_into_view_if_needed(timeout=UI_MS)
     start = image_state(view.image)
     assert start["loaded"], f"{what}: the explorer's image is not loaded before any move"
+    start_numbers = view.numbers.text_content().strip()
     start_text = readout(slider).inner_text().strip()
     assert start_text, f"{what}: the slider's readout shows no value"
 
@@ -578,6 +611,8 @@ def exercise_slider(view: ExplorerView, slider: Locator, what: str,
     assert at_end["digest"] != start["digest"], (
         f"{what}: after key {key} ({start_text} → {end_text}) the image was replaced by the "
         "same picture")
+    end_numbers = wait_for_other_text(view.numbers, start_numbers,
+                                      f"{what}, key {key}: the numbers line", timeout_ms)
 
     type_into_readout(slider, start_text)
     typed = wait_for_new_image(view.image, at_end, f"{what}, typing {start_text!r}",
@@ -594,3 +629,5 @@ def exercise_slider(view: ExplorerView, slider: Locator, what: str,
     again = wait_for_new_image(view.image, typed, f"{what}, key {key} again", timeout_ms)
     assert again["digest"] == at_end["digest"], (
         f"{what}: the same value ({end_text}) drew a different picture the second time")
+    wait_for_text(view.numbers, end_numbers,
+                  f"{what}, key {key} again: the numbers line", timeout_ms)

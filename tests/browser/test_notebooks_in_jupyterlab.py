@@ -4,8 +4,8 @@ Each course notebook is opened in JupyterLab in Chromium (a copy, so autosave ne
 touches the committed file), its outputs are cleared and Run > Run All Cells is
 clicked. The run must end with every code cell executed and no error output. Then
 every slider of every explorer is moved by keyboard and by typing into its readout,
-and each move must show a new picture; the browser must log no error. Screenshots go
-to ``build/screenshots/``.
+and each move must show a new picture and new numbers in the line above it; the
+browser must log no error. Screenshots go to ``build/screenshots/``.
 """
 
 from __future__ import annotations
@@ -74,6 +74,9 @@ def test_every_slider_redraws_in_jupyterlab(lab_page, lab_server: LabServer,
                 f"{notebook.name}, explorer {number}: expected one image, "
                 f"found {view.image.count()}")
             assert view.sliders, f"{notebook.name}, explorer {number} has no slider"
+            assert view.numbers.count() == 1, (
+                f"{notebook.name}, explorer {number}: expected one numbers line, "
+                f"found {view.numbers.count()}")
             for description, slider in iter_sliders(view):
                 exercise_slider(view, slider,
                                 f"{notebook.name}, explorer {number}, slider {description!r}")
