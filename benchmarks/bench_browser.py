@@ -5,12 +5,13 @@ Run: ``.venv/bin/python benchmarks/bench_browser.py`` (needs Chromium, e.g. Debi
 
 For every explorer of the pack, a one-cell notebook showing it is opened in
 JupyterLab in headless Chromium (the same server and helpers as ``tests/browser``)
-and run. Then the handle of its first slider is pressed End and Home in turn; the
-time from the key press to the explorer's image holding a new, loaded picture is
-measured in the page (``performance.now()`` at the key press, the image's ``load``
-event). It covers the whole round trip: the widget message to the kernel, the
-redraw, the PNG back over the websocket and its decoding. The median per explorer
-is printed; there is no pass/fail (issue 12's target: <= 120 ms on a quiet 2-core
+and run. Then the handle of its first slider is pressed Right and Left in turn (one
+step), then End and Home (end to end of the range). The time from the key press to
+the explorer's image holding a new, loaded picture is measured in the page
+(``performance.now()`` at the key press, the image's ``load`` event). It covers the
+whole round trip: the widget message to the kernel, the redraw, the PNG back over
+the websocket and its decoding. The median per explorer and kind of move is
+printed; there is no pass/fail (issue 12's target: <= 120 ms on a quiet 2-core
 machine).
 """
 
@@ -93,14 +94,22 @@ def write_notebooks(root: Path) -> list[Path]:
     return paths
 
 
-def time_presses(page, panel) -> list[float]:
-    """Press-to-picture times (ms) of the first slider of the notebook's explorer."""
+#: The two kinds of move timed: one slider step (the usual nudge) and end to end of the
+#: range (axis ranges may change there, which repaints the whole figure).
+MOVES = {"one step": ("ArrowRight", "ArrowLeft"), "end to end": ("End", "Home")}
+
+
+def time_presses(page, panel, keys: tuple[str, str]) -> list[float]:
+    """Press-to-picture times (ms) of the first slider of the notebook's explorer.
+
+    The two ``keys`` are pressed in turn, so the slider goes back and forth.
+    """
     (view,) = explorers(panel)
     handle = view.sliders[0].locator(".noUi-handle").element_handle()
     image = view.image.element_handle()
     times = []
     for press in range(WARM_UP + PRESSES):
-        key = "End" if press % 2 == 0 else "Home"
+        key = keys[press % 2]
         elapsed = page.evaluate(_TIMED_PRESS_JS, [handle, image, key])
         if press >= WARM_UP:
             times.append(float(elapsed))
@@ -140,12 +149,14 @@ def main() -> int:
                             panel = open_notebook(page, server, notebook.name,
                                                   workspace=notebook.stem)
                             clear_and_run_all(page, panel)
-                            times = time_presses(page, panel)
+                            times = {move: time_presses(page, panel, keys)
+                                     for move, keys in MOVES.items()}
                         finally:
                             context.close()
                             server.shutdown_kernels()
-                        print(f"  {name:27s} {statistics.median(times):7.1f} ms  "
-                              f"(min {min(times):.1f}, max {max(times):.1f})")
+                        print(f"  {name:27s} " + "; ".join(
+                            f"{move}: {statistics.median(t):6.1f} ms (min {min(t):.1f}, "
+                            f"max {max(t):.1f})" for move, t in times.items()))
                 finally:
                     browser.close()
         finally:
