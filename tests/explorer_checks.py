@@ -10,8 +10,11 @@ import io
 
 import numpy as np
 from matplotlib.axes import Axes
+from matplotlib.axis import Tick
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
+from matplotlib.legend import Legend
+from matplotlib.text import Text
 
 from lqe_helpers.scenario import DEFAULT
 
@@ -67,3 +70,23 @@ def fresh_figure(figsize: tuple[float, float] = (10.0, 5.0)) -> Figure:
     figure = Figure(figsize=figsize)
     FigureCanvasAgg(figure)
     return figure
+
+
+def assert_only_numbers_change(explorer, name: str, value: float) -> None:
+    """Moving slider ``name`` to ``value`` changes ``explorer.numbers``, no figure text.
+
+    Text is the costliest artist to repaint, so the numbers of a view live beside the
+    figure: no text in it (tick labels aside, which follow the axis limits) may
+    change, and no text or legend may be painted again over the moving data.
+    """
+    def texts() -> list[str]:
+        ticks = {label for tick in explorer.figure.findobj(Tick)
+                 for label in (tick.label1, tick.label2)}
+        return [text.get_text() for text in explorer.figure.findobj(Text) if text not in ticks]
+
+    before, numbers = texts(), explorer.numbers
+    explorer.sliders[name].value = value
+    assert texts() == before
+    assert explorer.numbers != numbers
+    repainted = explorer.layers._background.redrawn
+    assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]

@@ -8,11 +8,8 @@ import math
 
 import numpy as np
 import pytest
-from explorer_checks import line, png
-from matplotlib.axis import Tick
+from explorer_checks import assert_only_numbers_change, line, png
 from matplotlib.figure import Figure
-from matplotlib.legend import Legend
-from matplotlib.text import Text
 
 from lqe_helpers import experiments, model
 from lqe_helpers.explorers import background
@@ -90,20 +87,7 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
 
 
 def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
-    """Text is the costliest artist to repaint: the numbers live beside the figure."""
-
-    def texts() -> list[str]:  # tick labels follow the axis limits: left out
-        ticks = {label for tick in explorer.figure.findobj(Tick)
-                 for label in (tick.label1, tick.label2)}
-        return [text.get_text() for text in explorer.figure.findobj(Text) if text not in ticks]
-
-    before, numbers = texts(), explorer.numbers
-    explorer.sliders["jerk_std"].value = 10.0
-    assert texts() == before
-    assert explorer.numbers != numbers
-    # Nor is any text (titles, legends, labels) painted again over the moving data.
-    repainted = explorer.layers._background.redrawn
-    assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]
+    assert_only_numbers_change(explorer, "jerk_std", 10.0)
 
 
 def test_numbers_give_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
