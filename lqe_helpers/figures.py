@@ -494,7 +494,7 @@ def jerk_sweep_figure(jerk_stds: np.ndarray, intervals, systematic: np.ndarray,
     raw_mse : float
         MSE of the raw readings, σ_v² (cm²).
     derived : float
-        The σ_j derived from the physics (cm/s³), marked by a vertical line.
+        The σ_j the pack derives from the motion (cm/s³), marked by a vertical line.
 
     Returns
     -------

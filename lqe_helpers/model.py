@@ -55,7 +55,7 @@ def jerk_input_matrix(dt: float) -> np.ndarray:
 
 
 def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
-    """Process noise covariance ``Q = G σ_j² Gᵀ`` from the physics of the noise.
+    """Process noise covariance ``Q = G σ_j² Gᵀ`` of a jerk held constant over each step.
 
     Lesson 0.5 eq. (9) propagates an input's variance through its input matrix:
     ``P(k+1) = F P Fᵀ + G σ_u² Gᵀ``. Here the unknown input is the butterfly's jerk,

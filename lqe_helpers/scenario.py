@@ -20,11 +20,11 @@ def matched_jerk_std(amplitude: float, frequency: float, dt: float) -> float:
     white noise held over each step, so its acceleration performs a random walk whose
     variance grows as ``σ_j² Δt · T`` over a time T. The real acceleration of
     ``A sin(ωt)`` swings by its amplitude ``A ω²`` in a quarter period ``T = 1/(4f)``.
-    Equating the two spreads gives ``σ_j = A ω² / √(Δt / (4 f))``: the noise
-    intensity follows from the physics of the motion (Lesson 0.5), not from tuning.
-    The quarter period is our choice of time scale; half or a whole period would give
-    σ_j smaller by √2 or 2. The physics fixes the order of magnitude, and the choice
-    lands near the Monte Carlo MSE optimum (``tests/test_lessons.py`` checks this).
+    Equating the two spreads gives ``σ_j = A ω² / √(Δt / (4 f))``. The motion fixes
+    the form of Q (``G σ_j² Gᵀ``) and the order of magnitude of σ_j; the time scale is
+    a modelling choice, not physics: an eighth, a half or a whole period instead of a
+    quarter gives σ_j larger by √2 or smaller by √2 or 2. The quarter period lands near
+    the Monte Carlo MSE optimum (``tests/test_lessons.py`` checks this).
 
     Parameters
     ----------
