@@ -103,7 +103,8 @@ def browser(chromium_executable: str):
 def write_harness_notebook(path: Path) -> None:
     """A notebook that checks the harness: a live explorer, a dead one, an error.
 
-    The dead explorer's drawing ignores its slider, so its image never changes; the
+    The live explorer shows its values in its numbers line, as the course explorers
+    do. The dead explorer's drawing ignores its slider, so its image never changes; the
     cell after it raises; the last cell never runs.
     """
     live = '''import numpy as np
@@ -116,6 +117,7 @@ def draw(figure, *, amplitude, variance):
     t = np.linspace(0.0, 1.0, 50)
     ax.plot(t, amplitude * np.sin(2 * np.pi * t) + np.log10(variance), label="curve")
     ax.set_ylim(-12, 12)
+    return f"a = {amplitude:.2f} cm, P0 = {variance:.3g} cm²"
 
 
 Explorer("live", {"amplitude": float_slider("a (cm)", 1.0, 0.0, 10.0, 0.5),
