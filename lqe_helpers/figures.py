@@ -820,3 +820,478 @@ def bias_settling_figure(times: np.ndarray, mean_errors: dict[str, np.ndarray],
     ax_v.legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     return fig
+
+
+def _mean_band(ax, x: np.ndarray, intervals, role: str, label: str, **line) -> np.ndarray:
+    """Plot the means of ``intervals`` against ``x`` over their shaded 95 % band."""
+    mean, low, high = _interval_arrays(intervals)
+    ax.fill_between(x, low, high, color=COLORS[role], alpha=0.25, linewidth=0)
+    ax.plot(x, mean, **style(role, label=label, **line))
+    return mean
+
+
+def delay_sweep_figure(delays: np.ndarray, delayed, compensated, undelayed_mse: float,
+                       theory_delays: np.ndarray, theory: np.ndarray,
+                       late_eye_mse: np.ndarray, share, delay: float) -> Figure:
+    """What compensation wins as the delay grows: MSEs (left) and the share removed (right).
+
+    Parameters
+    ----------
+    delays : array_like, shape (s,)
+        The delays simulated (s), increasing, starting at 0.
+    delayed, compensated : sequence of metrics.Interval, length s
+        Monte Carlo MSE (cm²) of the delayed and of the compensated position.
+    undelayed_mse : float
+        MSE of the filter with no delay (cm²), drawn as a horizontal line.
+    theory_delays, theory : array_like, shape (t,)
+        Delays (s) and the theoretical MSE of the compensated position (cm²); only the
+        part within ``delays`` is drawn.
+    late_eye_mse : array_like, shape (s,)
+        MSE of the true position seen late (cm²); its first entry (no delay) is left out.
+    share : sequence of metrics.Interval, length s
+        Share of the delayed MSE that compensation removes, paired per run (1 = all).
+    delay : float
+        The question's delay (s), marked in both panels.
+
+    Returns
+    -------
+    Figure
+        Two panels: the MSEs against the delay (log scale; lines first the delayed, the
+        compensated, the theory, the late eye) and the share removed (its means the first
+        line), whose arrows point at the deepest loss before ``delay`` and the middle of the late
+        delays where compensation hurts (when there are such delays).
+    """
+    delays = np.asarray(delays, dtype=float)
+    theory_delays = np.asarray(theory_delays, dtype=float)
+    theory = np.asarray(theory, dtype=float)
+    late_eye_mse = np.asarray(late_eye_mse, dtype=float)
+    fig, (ax_mse, ax_share) = plt.subplots(1, 2, figsize=(11, 4.6),
+                                           gridspec_kw={"wspace": 0.28})
+    delayed_mean = _mean_band(ax_mse, delays, delayed, "estimate",
+                              "delayed estimate (simulation)")
+    compensated_mean = _mean_band(ax_mse, delays, compensated, "prediction",
+                                  "compensated (simulation)")
+    shown = theory_delays <= delays[-1] + 1e-9
+    ax_mse.plot(theory_delays[shown], theory[shown],
+                **style("reference", linewidth=2.2,
+                        label=r"compensated, theory $[P^*_\delta]_{pp}$"))
+    ax_mse.plot(delays[1:], late_eye_mse[1:],
+                **style("truth", linestyle=(0, (6, 2, 1, 2)), linewidth=1.1,
+                        label="perfect but late eye"))
+    ax_mse.axhline(undelayed_mse, **style("alternative", linewidth=1.1, label="undelayed filter"))
+    # Scaled to the estimates' MSEs: the late eye, near 0 at the shortest delays, is cut.
+    estimates = np.concatenate([delayed_mean, compensated_mean, theory[shown]])
+    estimates = estimates[estimates > 0]
+    ax_mse.set_yscale("log")
+    ax_mse.set_ylim(0.5 * estimates.min(), 2.0 * estimates.max())
+    share_mean = _mean_band(ax_share, delays, share, "prediction",
+                            "1 − MSE compensated / MSE delayed", linestyle="-", marker=".",
+                            markersize=4)
+    for ax in (ax_mse, ax_share):
+        ax.axvline(delay, color=COLORS["vision"], linewidth=1)
+        ax.set_xlim(0, delays[-1])
+        ax.set_xlabel("delay d (s)")
+    ax_mse.text(delay + 0.01 * delays[-1], 0.97, f"d = {delay} s", fontsize=9, color="0.35",
+                va="top", transform=ax_mse.get_xaxis_transform())
+    ax_mse.set_ylabel("position MSE (cm²)")
+    ax_mse.set_title("MSE against the delay")
+    ax_mse.legend(loc="lower right", fontsize=8.5)
+
+    _, share_low, share_high = _interval_arrays(share)
+    ax_share.axhline(0, color=COLORS["truth"], linewidth=0.9)
+    middle = 0.45 * delays[-1]
+    ax_share.text(middle, 0.03, "↑ compensation helps", fontsize=9, ha="center", va="bottom")
+    ax_share.text(middle, -0.03, "↓ compensation hurts", fontsize=9, ha="center", va="top")
+    blended = ax_share.get_xaxis_transform()          # x in data, y in axes fraction
+    arrow = {"arrowstyle": "->", "linewidth": 0.8}
+    early = (delays > 0) & (delays < delay) & (share_mean < 0)
+    if early.any():
+        i = int(np.flatnonzero(early)[np.argmin(share_mean[early])])
+        ax_share.annotate("too short to be\nworth the jitter", xy=(delays[i], share_mean[i]),
+                          xytext=(delays[i] + 0.14 * delays[-1], 0.2), textcoords=blended,
+                          fontsize=9, ha="center", va="top", arrowprops=arrow)
+    late = np.flatnonzero((delays > delay) & (share_mean < 0))
+    if late.size:
+        i = int(late[late.size // 2])
+        ax_share.annotate("so long that the\nprediction overshoots",
+                          xy=(delays[i], share_mean[i]),
+                          xytext=(delays[i] - 0.22 * delays[-1], 0.2), textcoords=blended,
+                          fontsize=9, ha="center", va="top", arrowprops=arrow)
+    ax_share.set_ylim(min(-0.1, share_low.min()) - 0.1, max(0.1, share_high.max()) + 0.15)
+    ax_share.set_ylabel("share of the delayed MSE removed")
+    ax_share.set_title("What compensation wins (paired, per run)")
+    ax_share.legend(loc="lower left", fontsize=8.5)
+    return fig
+
+
+def prediction_error_sources_figure(theory_delays: np.ndarray, theory: np.ndarray,
+                                    extrapolated: np.ndarray, jerks: np.ndarray,
+                                    delays: np.ndarray, compensated,
+                                    takeover: float) -> Figure:
+    """The theoretical prediction MSE against the delay, split into its two sources (log–log).
+
+    Parameters
+    ----------
+    theory_delays : array_like, shape (t,)
+        Delays (s) of the theory, increasing; only those > 0 are drawn.
+    theory, extrapolated, jerks : array_like, shape (t,)
+        Theoretical MSE of the compensated position (cm²): the total, the old estimation
+        error carried forward alone, and the jerks accumulated during the gap alone.
+    delays : array_like, shape (s,)
+        The delays simulated (s), starting at 0; shaded, and the simulated MSEs drawn.
+    compensated : sequence of metrics.Interval, length s
+        Monte Carlo MSE of the compensated position (cm²); its first entry is left out.
+    takeover : float
+        The delay (s) from which the jerks exceed the extrapolated error, marked.
+
+    Returns
+    -------
+    Figure
+        One log–log panel; lines in the order total, extrapolated, jerks, simulation.
+    """
+    theory_delays = np.asarray(theory_delays, dtype=float)
+    delays = np.asarray(delays, dtype=float)
+    positive = theory_delays > 0
+    x = theory_delays[positive]
+    theory = np.asarray(theory, dtype=float)[positive]
+    fig, ax = plt.subplots(figsize=(8, 4.6))
+    ax.plot(x, theory, **style("reference", linewidth=2.2, label="theory: total"))
+    ax.plot(x, np.asarray(extrapolated, dtype=float)[positive],
+            **style("estimate", linestyle="--", label="old estimation error, extrapolated"))
+    ax.plot(x, np.asarray(jerks, dtype=float)[positive],
+            **style("alternative", label="jerks accumulated during the gap"))
+    simulated, _, _ = _interval_arrays(compensated)
+    ax.plot(delays[1:], simulated[1:],
+            **style("prediction", linestyle="none", marker="o", markersize=3.5,
+                    label="compensated, simulation"))
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlim(x[0], x[-1])
+    ax.set_ylim(1e-4 * theory.min(), 10.0 * theory.max())
+    ax.set_xlabel("delay d (s)")
+    ax.set_ylabel("prediction MSE (cm²)")
+    ax.set_title("Where the prediction error comes from (theory)")
+    ax.axvspan(delays[1], delays[-1], color=COLORS["vision"], alpha=0.12, linewidth=0,
+               label="delays simulated in Figure 4")
+    ax.axvline(takeover, color=COLORS["truth"], linewidth=0.8)
+    ax.text(takeover * 0.93, 0.04, f"jerks take over\nfrom d = {takeover:.2f} s", fontsize=9,
+            ha="right", transform=ax.get_xaxis_transform())
+    ax.legend(loc="upper left", fontsize=9)
+    return fig
+
+
+def belief_and_error_figure(times: np.ndarray,
+                            filters: dict[str, tuple[np.ndarray, np.ndarray, float, str]],
+                            steady_variance: float, threshold: float, runs: int,
+                            until: float = 2.0,
+                            ylim: tuple[float, float] = (0.05, 15.0)) -> Figure:
+    """Each filter's actual squared error beside what it believes it to be, over time.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    filters : dict
+        Name (e.g. "P0 = diag(1)") → (Monte Carlo mean squared position error (cm²),
+        shape (n,); the filter's own position variance (cm²), shape (n,); its convergence
+        time (s); style role).
+    steady_variance : float
+        The steady-state position variance [P̂∞]pp (cm²).
+    threshold : float
+        The convergence threshold (cm²), e.g. 2 × the steady level.
+    runs : int
+        Number of Monte Carlo runs behind the mean, for the legend.
+    until : float
+        Last time shown (s), > 0.
+    ylim : (float, float)
+        Range of the logarithmic axis (cm²); a very uncertain start lies above it.
+
+    Returns
+    -------
+    Figure
+        One panel; for each filter in turn, its error line and then its variance line.
+    """
+    times = np.asarray(times, dtype=float)
+    if until <= 0:
+        raise ValueError(f"until must be > 0 s, got {until}")
+    window = times <= until
+    fig, ax = plt.subplots(figsize=(10, 4.8))
+    for name, (squared_error, own_variance, converged, role) in filters.items():
+        ax.plot(times[window], np.asarray(squared_error, dtype=float)[window],
+                **style(role, label=f"{name}: mean squared error ({runs} runs)"))
+        ax.plot(times[window], np.asarray(own_variance, dtype=float)[window],
+                **style(role, linestyle=":", linewidth=2.2, label=f"{name}: filter's own variance"))
+        ax.axvline(converged, color=COLORS[role], linewidth=1, alpha=0.7)
+        ax.text(converged, 0.97, f" converged\n {converged:.2f} s", color=COLORS[role],
+                fontsize=9, va="top", transform=ax.get_xaxis_transform())
+    ax.axhline(steady_variance, **style("reference", label="steady-state variance (theory)"))
+    ax.axhline(threshold, color=COLORS["vision"], linestyle="--", linewidth=1.2,
+               label="convergence threshold: 2 × steady level")
+    ax.set_yscale("log")
+    ax.set_ylim(*ylim)
+    ax.set_xlim(0, until)
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("squared position error (cm²)")
+    ax.set_title("The error over time: what each filter achieves, and what it believes")
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=3, fontsize=9)
+    return fig
+
+
+def gains_figure(times: np.ndarray, gains: dict[str, tuple[np.ndarray, str]],
+                 steady_gain: np.ndarray, until: float = 1.5) -> Figure:
+    """The gains of position, velocity and acceleration over time, one panel each (log scale).
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    gains : dict
+        Name (e.g. "P0 = diag(1)") → (the gains K_j of a one-sensor filter, shape (n, 3):
+        position (no unit), velocity (1/s), acceleration (1/s²); style role).
+    steady_gain : array_like, shape (3,)
+        The steady-state gain K∞, drawn in every panel.
+    until : float
+        Last time shown (s), > 0.
+
+    Returns
+    -------
+    Figure
+        Three panels (position, velocity, acceleration); in each, one line per entry of
+        ``gains`` in order, then K∞.
+    """
+    times = np.asarray(times, dtype=float)
+    steady_gain = np.asarray(steady_gain, dtype=float).reshape(-1)
+    if until <= 0:
+        raise ValueError(f"until must be > 0 s, got {until}")
+    early = times <= until
+    units = ("position gain", "velocity gain (1/s)", "acceleration gain (1/s²)")
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.8))
+    for state, (ax, unit) in enumerate(zip(axes, units, strict=True)):
+        for name, (gain, role) in gains.items():
+            ax.plot(times[early], np.asarray(gain, dtype=float)[early, state],
+                    **style(role, label=name))
+        ax.axhline(steady_gain[state], **style("reference", label="steady state K∞"))
+        ax.set_yscale("log")
+        ax.set_xlim(0, until)
+        ax.set_xlabel("time (s)")
+        ax.set_ylabel(unit)
+    for ax, title in zip(axes, ("position", "velocity", "acceleration"), strict=True):
+        ax.set_title(title)
+    fig.suptitle("Gains over time: P0 sets the start, not the end")
+    fig.legend(*axes[0].get_legend_handles_labels(), loc="lower center", ncol=3)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    return fig
+
+
+def _errorbar_intervals(ax, x: np.ndarray, intervals, role: str, **line) -> None:
+    """Means of ``intervals`` against ``x`` with their 95 % intervals as error bars."""
+    mean, low, high = _interval_arrays(intervals)
+    ax.errorbar(x, mean, yerr=[mean - low, high - mean], color=COLORS[role], markersize=4,
+                capsize=2, **line)
+
+
+def p0_sweep_figure(p0_grid: np.ndarray, convergence, start_up, settled, burn_in: float,
+                    question_values: dict[str, float], scales: dict[str, float],
+                    plateau: tuple[float, float], plateau_margin: float) -> Figure:
+    """Convergence time (left) and MSEs (right) against p0 in P0 = p0 · I, log axis.
+
+    Parameters
+    ----------
+    p0_grid : array_like, shape (s,)
+        The p0 swept (cm², cm²/s², cm²/s⁴), > 0.
+    convergence : sequence of metrics.Interval, length s
+        Convergence time (s) with its 95 % interval.
+    start_up, settled : sequence of metrics.Interval, length s
+        Position MSE (cm²) over the first ``burn_in`` seconds and after them.
+    burn_in : float
+        Length of the start-up window (s), for the legend.
+    question_values : dict
+        Label (e.g. "diag(1)") → p0 of the question, marked grey.
+    scales : dict
+        Label (e.g. "A²") → a squared scale of the flight, marked pink dotted.
+    plateau : (float, float)
+        The range of p0 whose start-up MSE is within ``plateau_margin`` of the best, shaded.
+    plateau_margin : float
+        That margin as a fraction (0.1 = 10 %), for the legend.
+
+    Returns
+    -------
+    Figure
+        Two panels sharing the p0 axis.
+    """
+    p0_grid = np.asarray(p0_grid, dtype=float)
+    fig, (ax_t, ax_m) = plt.subplots(1, 2, figsize=(11, 4.2))
+    _errorbar_intervals(ax_t, p0_grid, convergence, "estimate", marker="o",
+                        label="convergence time")
+    ax_t.set_ylabel("convergence time (s)")
+    _errorbar_intervals(ax_m, p0_grid, start_up, "estimate", marker="o",
+                        label=f"MSE over the first {burn_in:g} s")
+    _errorbar_intervals(ax_m, p0_grid, settled, "alternative", marker="s", linestyle="-.",
+                        label=f"MSE after {burn_in:g} s")
+    ax_m.set_ylabel("position MSE (cm²)")
+    ax_m.set_ylim(0, None)
+    for ax in (ax_t, ax_m):
+        ax.set_xscale("log")
+        ax.set_xlabel("p0 in P0 = p0 · I (cm², cm²/s², cm²/s⁴)")
+        for text, value in question_values.items():
+            ax.axvline(value, color=COLORS["vision"], linewidth=1)
+            ax.annotate(text, (value, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -12),
+                        textcoords="offset points", color=COLORS["vision"], fontsize=9)
+        ax.axvspan(plateau[0], plateau[-1], color=COLORS["estimate"], alpha=0.12, linewidth=0,
+                   label=f"plateau: start-up MSE within {100 * plateau_margin:.0f} % of best")
+        for k, (name, value) in enumerate(scales.items()):
+            ax.axvline(value, **style("reference", label="squared scales of the flight"
+                                      if k == 0 else None))
+            ax.annotate(name, (value, 0.88), xycoords=("data", "axes fraction"), xytext=(2, 0),
+                        textcoords="offset points", color=COLORS["reference"], fontsize=9)
+        ax.legend(loc="center right", fontsize=9)
+    ax_t.set_title("How long the start-up lasts")
+    ax_m.set_title("How much it costs, and what stays the same")
+    fig.tight_layout()
+    return fig
+
+
+def _plain_log_ticks(ax, axis: str, ticks) -> None:
+    """Put ``ticks`` on a log ``axis`` ("x" or "y") labelled as plain numbers (0.3, not 3e-1)."""
+    if ticks is None:
+        return
+    ticks = list(ticks)
+    labels = [f"{tick:g}" for tick in ticks]
+    if axis == "x":
+        ax.set_xticks(ticks, labels)
+    else:
+        ax.set_yticks(ticks, labels)
+        ax.yaxis.set_minor_locator(plt.NullLocator())
+
+
+def proprioception_sweep_figure(sigma_p: np.ndarray, fused, margin, dense_sigma_p: np.ndarray,
+                                theory_fused: np.ndarray, theory_margin: np.ndarray,
+                                vision, theory_vision: float, sigma_v: float,
+                                marks: dict[str, float], ticks=None) -> Figure:
+    """Fused MSE (left) and what proprioception wins (right) against σ_p, log axis.
+
+    Parameters
+    ----------
+    sigma_p : array_like, shape (s,)
+        The σ_p simulated (cm), increasing.
+    fused : sequence of metrics.Interval, length s
+        Monte Carlo MSE of the fused position (cm²) at each σ_p.
+    margin : sequence of metrics.Interval, length s
+        MSE lowered by proprioception in % of the vision-only MSE, paired per run.
+    dense_sigma_p, theory_fused, theory_margin : array_like, shape (t,)
+        σ_p (cm) of the theory curves, the steady-state fused variance (cm²) and the
+        improvement in % it predicts.
+    vision : metrics.Interval
+        Monte Carlo MSE of vision alone (cm²), a horizontal line with its band.
+    theory_vision : float
+        Steady-state variance of vision alone (cm²).
+    sigma_v : float
+        σ_v of the runs (cm), for the title.
+    marks : dict
+        Label (e.g. "(c)") → a σ_p (cm) to mark with a dashed line.
+    ticks : sequence of float, optional
+        Ticks of the σ_p axis, labelled as plain numbers.
+
+    Returns
+    -------
+    Figure
+        Two panels; in each the simulation is the first line, the theory the second.
+    """
+    sigma_p = np.asarray(sigma_p, dtype=float)
+    fig, (ax_mse, ax_margin) = plt.subplots(1, 2, figsize=(11, 4.4),
+                                            gridspec_kw={"wspace": 0.28})
+    _, _, fused_high = _interval_arrays(fused)
+    _mean_band(ax_mse, sigma_p, fused, "estimate", "fused, simulation (95 % CI band)",
+               marker="o", markersize=3.5)
+    ax_mse.plot(dense_sigma_p, theory_fused,
+                **style("reference", linewidth=2, label="fused, theory (steady state)"))
+    ax_mse.axhspan(vision.low, vision.high, color=COLORS["alternative"], alpha=0.2, linewidth=0)
+    ax_mse.axhline(vision.mean, **style("alternative", label="vision only, simulation"))
+    ax_mse.axhline(theory_vision, **style("reference", color=COLORS["alternative"],
+                                          linestyle=(0, (7, 3)), label="vision only, theory"))
+    ax_mse.set_ylim(0, 1.15 * max(vision.high, theory_vision, fused_high.max()))
+    ax_mse.set_ylabel("position MSE (cm²)")
+    ax_mse.set_title(f"Fused MSE against σ_p (σ_v = {sigma_v} cm)")
+    ax_mse.legend(loc="lower right", fontsize=8.5, handlelength=3.5)
+
+    _mean_band(ax_margin, sigma_p, margin, "estimate", "simulation, paired (95 % CI band)",
+               marker="o", markersize=3.5)
+    ax_margin.plot(dense_sigma_p, theory_margin,
+                   **style("reference", linewidth=2, label="theory (steady state)"))
+    ax_margin.axhline(0, color=COLORS["truth"], linewidth=0.8)
+    ax_margin.set_ylabel("MSE lowered by proprioception (%)")
+    ax_margin.set_title("The benefit of the extra sense")
+    ax_margin.legend(loc="center right", fontsize=8.5)
+    for ax in (ax_mse, ax_margin):
+        ax.set_xscale("log")
+        ax.set_xlim(sigma_p[0], sigma_p[-1])
+        ax.set_xlabel("σ_p (cm), log scale")
+        _plain_log_ticks(ax, "x", ticks)
+        for question, value in marks.items():
+            ax.axvline(value, color="grey", linewidth=0.8, linestyle="--")
+            ax.annotate(question, (value, 1.0), xycoords=("data", "axes fraction"),
+                        xytext=(3, -12), textcoords="offset points", fontsize=9, color="grey")
+    return fig
+
+
+def assumed_noise_figure(assumed_sigma_p: np.ndarray, fused, excess, vision_mse: float,
+                         vision_excess: float, sigma_p: float, sigma_v: float, runs: int,
+                         ticks=None, mse_ticks=None) -> Figure:
+    """MSE of a filter that assumes σ̃_p (left) and its cost over the right model (right, zoom).
+
+    Parameters
+    ----------
+    assumed_sigma_p : array_like, shape (s,)
+        The σ̃_p the filter assumes (cm), increasing.
+    fused : sequence of metrics.Interval, length s
+        Monte Carlo MSE of the fused position (cm²) at each σ̃_p.
+    excess : sequence of metrics.Interval, length s
+        Extra MSE over the filter that assumes the true σ_p (cm²), paired per run.
+    vision_mse : float
+        Monte Carlo MSE of vision alone (cm²).
+    vision_excess : float
+        Extra MSE of vision alone over the correctly informed fused filter (cm²); the
+        zoom on the right reaches 1.8 times it.
+    sigma_p, sigma_v : float
+        The true noise levels (cm), σ_p marked with a dashed line.
+    runs : int
+        Number of Monte Carlo runs, for the title.
+    ticks, mse_ticks : sequence of float, optional
+        Ticks of the σ̃_p axis and of the left panel's MSE axis, as plain numbers.
+
+    Returns
+    -------
+    Figure
+        Two panels; the means are the first line of each.
+    """
+    assumed_sigma_p = np.asarray(assumed_sigma_p, dtype=float)
+    fig, (ax, ax_cost) = plt.subplots(1, 2, figsize=(11, 4.4), gridspec_kw={"wspace": 0.28})
+    _mean_band(ax, assumed_sigma_p, fused, "estimate", "fused, filter assumes σ̃_p",
+               marker="o", markersize=4)
+    ax.axhline(vision_mse, **style("alternative", label="vision only"))
+    ax.set_yscale("log")
+    _plain_log_ticks(ax, "y", mse_ticks)
+    ax.set_ylabel("position MSE (cm²), log scale")
+    ax.set_title("MSE when the filter assumes σ̃_p")
+    ax.text(0.04, 0.25, "← overtrust", fontsize=10, color="grey", transform=ax.transAxes)
+    ax.text(0.96, 0.25, "undertrust →", fontsize=10, color="grey", ha="right",
+            transform=ax.transAxes)
+
+    _mean_band(ax_cost, assumed_sigma_p, excess, "estimate",
+               "fused, filter assumes σ̃_p (paired, 95 % CI band)", marker="o", markersize=4)
+    ax_cost.axhline(vision_excess, **style("alternative", label="vision only"))
+    ax_cost.axhline(0, color=COLORS["truth"], linewidth=0.8)
+    top = 1.8 * vision_excess
+    ax_cost.set_ylim(-top / 12, top)
+    ax_cost.set_ylabel("extra MSE over the correct model (cm²)")
+    ax_cost.set_title("Zoom: the cost of misjudging σ_p")
+    for axis in (ax, ax_cost):
+        axis.axvline(sigma_p, **style("truth", linewidth=1, linestyle="--",
+                                      label=f"true σ_p = {sigma_p} cm"))
+        axis.set_xscale("log")
+        _plain_log_ticks(axis, "x", ticks)
+        axis.set_xlabel("σ̃_p assumed by the filter (cm), log scale")
+        axis.legend(loc="upper right", fontsize=8.5)
+    fig.suptitle(f"Misjudging proprioception: true σ_v = {sigma_v} cm, σ_p = {sigma_p} cm "
+                 f"({runs} runs)", y=1.0)
+    return fig

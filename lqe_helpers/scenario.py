@@ -13,14 +13,15 @@ import numpy as np
 from . import model, simulation, validation
 
 
-def matched_jerk_std(amplitude: float, frequency: float, dt: float) -> float:
+def matched_jerk_std(amplitude: float, frequency: float, dt: float,
+                     period_fraction: float = 0.25) -> float:
     """Jerk noise σ_j (cm/s³) whose random walk matches the sinusoid's change of acceleration.
 
     The filter does not know the butterfly flies a sinusoid; it treats the jerk as
     white noise held over each step, so its acceleration performs a random walk whose
     variance grows as ``σ_j² Δt · T`` over a time T. The real acceleration of
     ``A sin(ωt)`` swings by its amplitude ``A ω²`` in a quarter period ``T = 1/(4f)``.
-    Equating the two spreads gives ``σ_j = A ω² / √(Δt / (4 f))``. The motion fixes
+    Equating the two spreads gives ``σ_j = A ω² / √(Δt T)``. The motion fixes
     the form of Q (``G σ_j² Gᵀ``) and the order of magnitude of σ_j; the time scale is
     a modelling choice, not physics: an eighth, a half or a whole period instead of a
     quarter gives σ_j larger by √2 or smaller by √2 or 2. The quarter period lands near
@@ -34,6 +35,9 @@ def matched_jerk_std(amplitude: float, frequency: float, dt: float) -> float:
         Sinusoid frequency f in Hz, > 0.
     dt : float
         Time step Δt in s, > 0.
+    period_fraction : float
+        The time scale T as a fraction of the flight's period, > 0: ``T =
+        period_fraction / f``. The default, a quarter, is the pack's choice.
 
     Returns
     -------
@@ -43,8 +47,10 @@ def matched_jerk_std(amplitude: float, frequency: float, dt: float) -> float:
     amplitude = validation.positive("amplitude", amplitude, "cm")
     frequency = validation.positive("frequency", frequency, "Hz")
     dt = validation.positive("dt", dt, "s")
+    period_fraction = validation.positive("period_fraction", period_fraction)
     omega = 2.0 * np.pi * frequency
-    return float(amplitude * omega**2 / np.sqrt(dt / (4.0 * frequency)))
+    time_scale = period_fraction / frequency
+    return float(amplitude * omega**2 / np.sqrt(dt * time_scale))
 
 
 @dataclass(frozen=True)

@@ -280,3 +280,161 @@ def test_bias_settling_figure_draws_mean_errors_and_filter_stds():
         plt.close(fig)
     with pytest.raises(ValueError, match="until"):
         figures.bias_settling_figure(times, {}, {}, until=0.0)
+
+
+def _sweep():
+    """A small delay sweep: 0–0.4 s, compensation hurting first and last."""
+    delays = np.linspace(0.0, 0.4, 5)
+    share = [-0.0, -0.3, 0.5, 0.2, -0.4]
+    delayed = _intervals([1.0, 2.0, 4.0, 8.0, 16.0])
+    compensated = _intervals([1.0, 2.5, 2.0, 6.0, 20.0])
+    return delays, delayed, compensated, _intervals(share)
+
+
+def test_delay_sweep_figure_draws_both_panels_and_points_at_the_losses():
+    delays, delayed, compensated, share = _sweep()
+    theory_delays = np.linspace(0.0, 1.0, 11)
+    fig = figures.delay_sweep_figure(delays, delayed, compensated, 1.0, theory_delays,
+                                     theory_delays + 1.0, delays**2, share, delay=0.15)
+    try:
+        ax_mse, ax_share = fig.axes
+        lines = ax_mse.get_lines()
+        np.testing.assert_array_equal(lines[0].get_ydata(), [1.0, 2.0, 4.0, 8.0, 16.0])
+        np.testing.assert_array_equal(lines[1].get_ydata(), [1.0, 2.5, 2.0, 6.0, 20.0])
+        np.testing.assert_allclose(lines[2].get_xdata(), theory_delays[:5])  # within the sweep
+        np.testing.assert_allclose(lines[3].get_ydata(), (delays**2)[1:])    # no d = 0
+        assert ax_mse.get_yscale() == "log"
+        assert ax_mse.get_xlim() == ax_share.get_xlim() == (0.0, 0.4)
+        np.testing.assert_array_equal(ax_share.get_lines()[0].get_ydata(),
+                                      [interval.mean for interval in share])
+        arrows = [text for text in ax_share.texts if hasattr(text, "xy")]
+        # The deepest loss before the question's delay (0.15 s) and the late one.
+        assert [tuple(np.round(arrow.xy, 6)) for arrow in arrows] == [(0.1, -0.3), (0.4, -0.4)]
+    finally:
+        plt.close(fig)
+
+
+def test_delay_sweep_figure_draws_no_arrow_where_compensation_never_hurts():
+    delays, delayed, compensated, _ = _sweep()
+    fig = figures.delay_sweep_figure(delays, delayed, compensated, 1.0, delays, delays + 1.0,
+                                     delays**2, _intervals([0.0, 0.1, 0.5, 0.2, 0.1]), 0.1)
+    try:
+        assert not [text for text in fig.axes[1].texts if hasattr(text, "xy")]
+    finally:
+        plt.close(fig)
+
+
+def test_prediction_error_sources_figure_draws_theory_parts_and_simulation():
+    theory_delays = np.array([0.0, 0.01, 0.1, 1.0])
+    extrapolated = np.array([0.5, 0.6, 2.0, 50.0])
+    jerks = np.array([0.0, 1e-6, 1e-2, 100.0])
+    fig = figures.prediction_error_sources_figure(
+        theory_delays, extrapolated + jerks, extrapolated, jerks, np.array([0.0, 0.01, 0.02]),
+        _intervals([0.5, 0.61, 0.7]), takeover=0.8)
+    try:
+        ax, = fig.axes
+        lines = ax.get_lines()
+        np.testing.assert_allclose(lines[0].get_xdata(), [0.01, 0.1, 1.0])   # d > 0 only
+        np.testing.assert_allclose(lines[0].get_ydata(), (extrapolated + jerks)[1:])
+        np.testing.assert_allclose(lines[1].get_ydata(), extrapolated[1:])
+        np.testing.assert_allclose(lines[2].get_ydata(), jerks[1:])
+        np.testing.assert_allclose(lines[3].get_ydata(), [0.61, 0.7])
+        assert ax.get_xscale() == ax.get_yscale() == "log"
+        assert any("from d = 0.80 s" in text.get_text() for text in ax.texts)
+    finally:
+        plt.close(fig)
+
+
+def test_belief_and_error_figure_draws_error_then_belief_for_each_filter():
+    times = np.arange(300) * 0.01
+    error = 1.0 + np.exp(-times)
+    belief = 0.5 + np.exp(-2 * times)
+    fig = figures.belief_and_error_figure(
+        times, {"P0 = diag(1)": (error, belief, 0.4, "estimate"),
+                "P0 = diag(1e5)": (2 * error, 2 * belief, 0.1, "alternative")},
+        steady_variance=0.4, threshold=0.8, runs=50)
+    try:
+        ax, = fig.axes
+        lines = ax.get_lines()
+        shown = times <= 2.0
+        np.testing.assert_allclose(lines[0].get_ydata(), error[shown])
+        np.testing.assert_allclose(lines[1].get_ydata(), belief[shown])
+        np.testing.assert_allclose(lines[3].get_ydata(), 2 * error[shown])   # after a mark
+        assert lines[0].get_label() == "P0 = diag(1): mean squared error (50 runs)"
+        assert [text.get_text() for text in ax.texts] == [" converged\n 0.40 s",
+                                                          " converged\n 0.10 s"]
+        assert ax.get_yscale() == "log" and ax.get_xlim() == (0.0, 2.0)
+    finally:
+        plt.close(fig)
+
+
+def test_gains_figure_draws_one_panel_per_state_with_the_steady_gain():
+    times = np.arange(200) * 0.01
+    gain = np.stack([0.1 + times, 1 + times, 10 + times], axis=-1)       # (n, 3)
+    fig = figures.gains_figure(times, {"P0 = diag(1)": (gain, "estimate")},
+                               np.array([[0.5], [5.0], [50.0]]))
+    try:
+        assert len(fig.axes) == 3
+        early = times <= 1.5
+        for state, ax in enumerate(fig.axes):
+            first, steady = ax.get_lines()
+            np.testing.assert_allclose(first.get_ydata(), gain[early, state])
+            assert steady.get_ydata()[0] == [0.5, 5.0, 50.0][state]
+            assert ax.get_yscale() == "log"
+    finally:
+        plt.close(fig)
+
+
+def test_p0_sweep_figure_draws_convergence_and_both_mses_against_p0():
+    grid = np.logspace(-2, 6, 5)
+    fig = figures.p0_sweep_figure(
+        grid, _intervals([0.5, 0.3, 0.1, 0.1, 0.2]), _intervals([3.0, 2.0, 1.0, 1.0, 1.5]),
+        _intervals([0.4, 0.4, 0.4, 0.4, 0.4], half=0.01), 1.0, {"diag(1)": 1.0},
+        {"A²": 100.0}, (1.0, 1e4), 0.1)
+    try:
+        ax_t, ax_m = fig.axes
+        assert ax_t.get_xscale() == ax_m.get_xscale() == "log"
+        np.testing.assert_allclose(ax_t.get_lines()[0].get_ydata(), [0.5, 0.3, 0.1, 0.1, 0.2])
+        labels = ax_m.get_legend_handles_labels()[1]
+        assert "MSE over the first 1 s" in labels and "MSE after 1 s" in labels
+        assert "plateau: start-up MSE within 10 % of best" in labels
+    finally:
+        plt.close(fig)
+
+
+def test_proprioception_sweep_figure_draws_simulation_and_theory_in_both_panels():
+    from lqe_helpers.metrics import Interval
+
+    sigma_p = np.array([0.3, 1.5, 4.5, 100.0])
+    fig = figures.proprioception_sweep_figure(
+        sigma_p, _intervals([0.05, 0.2, 0.35, 0.38], half=0.01),
+        _intervals([90.0, 45.0, 10.0, 0.0]), np.geomspace(0.3, 100, 7), np.linspace(0, 0.4, 7),
+        np.linspace(90, 0, 7), Interval(0.38, 0.37, 0.39, 10), 0.4, 1.5,
+        {"(c)": 1.5, "(d)": 4.5}, ticks=[0.3, 1, 3, 10, 30, 100])
+    try:
+        ax_mse, ax_margin = fig.axes
+        np.testing.assert_allclose(ax_mse.get_lines()[0].get_ydata(), [0.05, 0.2, 0.35, 0.38])
+        np.testing.assert_allclose(ax_margin.get_lines()[0].get_ydata(), [90, 45, 10, 0])
+        assert ax_mse.get_ylim() == pytest.approx((0.0, 1.15 * 0.4))
+        assert [label.get_text() for label in ax_mse.get_xticklabels()] == [
+            "0.3", "1", "3", "10", "30", "100"]
+        assert [text.get_text() for text in ax_margin.texts] == ["(c)", "(d)"]
+    finally:
+        plt.close(fig)
+
+
+def test_assumed_noise_figure_zooms_on_the_cost_of_misjudging():
+    assumed = np.array([0.5, 1.5, 4.5, 13.5, 40.0])
+    fig = figures.assumed_noise_figure(
+        assumed, _intervals([3.0, 1.0, 0.35, 0.37, 0.38], half=0.01),
+        _intervals([2.6, 0.6, 0.0, 0.02, 0.03], half=0.002), 0.38, 0.032, 4.5, 1.5, 300,
+        ticks=[0.5, 1, 2, 5, 10, 20, 40], mse_ticks=[0.4, 1, 3])
+    try:
+        ax, ax_cost = fig.axes
+        np.testing.assert_allclose(ax.get_lines()[0].get_ydata(), [3.0, 1.0, 0.35, 0.37, 0.38])
+        assert ax.get_yscale() == "log" and ax_cost.get_yscale() == "linear"
+        assert ax_cost.get_ylim() == pytest.approx((-1.8 * 0.032 / 12, 1.8 * 0.032))
+        assert [label.get_text() for label in ax.get_yticklabels()] == ["0.4", "1", "3"]
+        assert "300 runs" in fig.get_suptitle()
+    finally:
+        plt.close(fig)

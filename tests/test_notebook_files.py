@@ -6,8 +6,9 @@ fresh kernel, carries no widget state, shows no error, and follows the pack's
 conventions (``/work``'s STYLE and README): known cell tags only (explorers marked for
 nbval, worked answers marked for the student edition, which builds), the ``lqe``
 metadata with the tutorial's marks, a core path of at most 1,500 words of markdown
-ended by ``## Going further``, a check after every core task of a question notebook,
-and every static figure shown with its description through ``plotting.show_figure``.
+ended by ``## Going further``, a check after every core task (the background and bonus
+notebooks too), and every static figure shown with its description through
+``plotting.show_figure``.
 """
 
 from __future__ import annotations
@@ -167,7 +168,7 @@ def test_a_short_core_path_then_going_further(path):
     assert len(headings) == 1, f"{path.name}: {len(headings)} Going further headings"
 
 
-@pytest.mark.parametrize("path", QUESTIONS, ids=lambda path: path.stem)
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_a_check_right_after_every_core_task(path):
     notebook = nbformat.read(path, as_version=4)
     cells, end = notebook.cells, core_end(notebook)

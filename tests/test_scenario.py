@@ -29,6 +29,21 @@ def test_matched_jerk_std_equates_random_walk_and_sinusoid_spreads() -> None:
     assert replace(DEFAULT, jerk_std=5.0).process_jerk_std == 5.0
 
 
+@pytest.mark.parametrize("period_fraction", [1 / 8, 1 / 2, 1.0])
+def test_matched_jerk_std_over_another_time_scale(period_fraction: float) -> None:
+    sigma = matched_jerk_std(10.0, 0.5, 0.01, period_fraction=period_fraction)
+    time_scale = period_fraction / 0.5
+    assert np.sqrt(sigma**2 * 0.01 * time_scale) == pytest.approx(10.0 * np.pi**2)
+    # Twice the time scale, √2 less jerk noise.
+    quarter = matched_jerk_std(10.0, 0.5, 0.01)
+    assert sigma / quarter == pytest.approx(np.sqrt(0.25 / period_fraction))
+
+
+def test_matched_jerk_std_rejects_a_time_scale_that_is_not_positive() -> None:
+    with pytest.raises(ValueError, match=r"period_fraction must be .* > 0, got 0"):
+        matched_jerk_std(10.0, 0.5, 0.01, period_fraction=0.0)
+
+
 def test_truth_is_the_sinusoid() -> None:
     np.testing.assert_allclose(DEFAULT.truth[:, 0], 10 * np.sin(np.pi * DEFAULT.times))
 

@@ -130,7 +130,7 @@ def test_the_pack_holds_what_a_student_needs_and_nothing_of_the_instructor(pack)
     assert all(name.startswith(f"{sp.PACK_NAME}/") for name in listed)
     inside = {name.removeprefix(f"{sp.PACK_NAME}/") for name in listed}
     for needed in ("Makefile", "README.md", "pyproject.toml", "constraints.txt",
-                   sp.MARKER_NAME, "lqe_helpers/__init__.py", "lqe_helpers/checks.py",
+                   sp.MARKER_NAME, "lqe_helpers/__init__.py", "lqe_helpers/checks/__init__.py",
                    "lqe_helpers/explorers/__init__.py", "tests/conftest.py",
                    f"tests/{sp.STRUCTURE_TEST}", f"tests/{sp.CONVENTIONS_NAME}"):
         assert needed in inside, needed

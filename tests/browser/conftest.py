@@ -101,10 +101,11 @@ def browser(chromium_executable: str):
 
 
 def write_harness_notebook(path: Path) -> None:
-    """A notebook that checks the harness: a live explorer, a dead one, an error.
+    """A notebook that checks the harness: a live explorer, two broken ones, an error.
 
     The live explorer shows its values in its numbers line, as the course explorers
     do. The dead explorer's drawing ignores its slider, so its image never changes; the
+    frozen explorer redraws its figure but always shows the same numbers line; the
     cell after it raises; the last cell never runs.
     """
     live = '''import numpy as np
@@ -129,11 +130,19 @@ Explorer("live", {"amplitude": float_slider("a (cm)", 1.0, 0.0, 10.0, 0.5),
 
 Explorer("dead", {"ignored": float_slider("ignored (cm)", 1.0, 0.0, 2.0, 0.5)},
          draw_nothing_new)'''
+    frozen = '''def draw_stale_numbers(figure, *, slope):
+    figure.clear()
+    figure.add_subplot().plot([0, 1], [0, slope])
+    return "slope = 1.00"
+
+
+Explorer("frozen", {"slope": float_slider("slope", 1.0, 0.0, 2.0, 0.5)}, draw_stale_numbers)'''
     notebook = nbformat.v4.new_notebook(
         cells=[
             nbformat.v4.new_markdown_cell("# Harness self-test"),
             nbformat.v4.new_code_cell(live, metadata={"tags": ["explorer"]}),
             nbformat.v4.new_code_cell(dead, metadata={"tags": ["explorer"]}),
+            nbformat.v4.new_code_cell(frozen, metadata={"tags": ["explorer"]}),
             nbformat.v4.new_code_cell('raise RuntimeError("deliberate failure")'),
             nbformat.v4.new_code_cell('print("never runs")'),
         ],

@@ -1,8 +1,9 @@
 """The harness can fail: it tells a live explorer from a dead one and sees errors.
 
 A small notebook written by the fixtures holds a live explorer (a linear and a log
-slider), a dead one whose drawing ignores its slider, a cell that raises and a cell
-after it. The checks that the course notebooks pass must catch each defect here.
+slider), a dead one whose drawing ignores its slider, a frozen one whose figure moves
+but whose numbers line does not, a cell that raises and a cell after it. The checks
+that the course notebooks pass must catch each defect here.
 """
 
 from __future__ import annotations
@@ -40,9 +41,9 @@ def test_harness_catches_errors_skipped_cells_and_dead_sliders(lab_page,
     problems = error_outputs(page, panel)
     assert len(problems) == 1, problems
     assert "RuntimeError" in problems[0] and "deliberate failure" in problems[0]
-    assert unexecuted_cells(page, panel) == ['code cell 4: print("never runs")']
+    assert unexecuted_cells(page, panel) == ['code cell 5: print("never runs")']
 
-    live, dead = explorers(panel)
+    live, dead, frozen = explorers(panel)
     assert [description for description, _ in iter_sliders(live)] == ["a (cm)", "P0 (cm²)"]
     for description, slider in iter_sliders(live):
         exercise_slider(live, slider, f"live slider {description}")
@@ -59,6 +60,9 @@ def test_harness_catches_errors_skipped_cells_and_dead_sliders(lab_page,
 
     with pytest.raises(AssertionError, match="did not change"):
         exercise_slider(dead, dead_slider, "dead slider", timeout_ms=2_000)
+    (_, frozen_slider), = iter_sliders(frozen)
+    with pytest.raises(AssertionError, match=r"numbers line still shows 'slope = 1\.00'"):
+        exercise_slider(frozen, frozen_slider, "frozen numbers", timeout_ms=2_000)
     live.output.screenshot(path=screenshot_path("harness-live-explorer"))
     page.screenshot(path=screenshot_path("harness"))
 
