@@ -96,7 +96,7 @@ def shape_text(item: object) -> str:
 
 
 def as_result_array(output: object, name: str, expected: tuple[int, ...],
-                     what: str) -> np.ndarray:
+                    what: str) -> np.ndarray:
     """The student's return value as a float array, or CheckFailed if it is not one.
 
     ``what`` describes the expected result (e.g. "the estimates ẑ") and ``expected`` its
@@ -130,8 +130,8 @@ def as_result_array(output: object, name: str, expected: tuple[int, ...],
 
 
 def match_mistake(mistakes: dict[str, str], compute: Callable[[str, int], np.ndarray | None],
-                   answers: dict[int, np.ndarray], correct: dict[int, np.ndarray],
-                   rows: Callable[[int], slice] | None = None) -> str | None:
+                  answers: dict[int, np.ndarray], correct: dict[int, np.ndarray],
+                  rows: Callable[[int], slice] | None = None) -> str | None:
     """The first mistake whose result equals the student's answer on every model it can run.
 
     ``answers`` maps model index → the student's (right-shaped) result; ``compute(mistake,
@@ -157,7 +157,7 @@ def match_mistake(mistakes: dict[str, str], compute: Callable[[str, int], np.nda
 
 
 def call_student(function: Callable, name: str, args: tuple, where: str, shape_hint: str = "",
-          hint: str = "") -> object:
+                 hint: str = "") -> object:
     """``function(*args)``; NotImplementedError and other exceptions become CheckFailed.
 
     ``shape_hint`` is added to the message when the error is about shapes, ``hint``

@@ -176,8 +176,8 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
         _check_compensation_head(name, answer, case)
     _check_zero_delay(compensate, name)
     passed(f"{name} matches eq. (7) (z*_j = A^δ ẑ_(j−δ), NaN before δ) on "
-            f"{len(cases)} random cases (1–4 states, δ = 1–4) and with δ = 0, to "
-            f"{tolerance_text(FUNCTION_RTOL)}")
+           f"{len(cases)} random cases (1–4 states, δ = 1–4) and with δ = 0, to "
+           f"{tolerance_text(FUNCTION_RTOL)}")
 
 
 def _match_core(compute: Callable[[str, int], np.ndarray | None],
@@ -208,7 +208,7 @@ def _match_core(compute: Callable[[str, int], np.ndarray | None],
 def _run_compensation(compensate: Callable, name: str, case: _CompensationCase) -> np.ndarray:
     estimates, A = case.estimates.copy(), case.A.copy()
     output = call_student(compensate, name, (estimates, A, case.delay), case.describe(),
-                   shape_hint=_COMPENSATION_SHAPE_HINT)
+                          shape_hint=_COMPENSATION_SHAPE_HINT)
     if not np.array_equal(estimates, case.estimates) or not np.array_equal(A, case.A):
         raise CheckFailed(
             f"{name} changed its input estimates or A in place (on {case.describe()}). "
@@ -274,7 +274,7 @@ def _check_zero_delay(compensate: Callable, name: str) -> None:
     A = np.eye(3) + 0.4 * rng.normal(size=(3, 3))
     case = _CompensationCase(estimates, A, 0)
     output = call_student(compensate, name, (estimates.copy(), A.copy(), 0), case.describe(),
-                   hint=_ZERO_DELAY_HINT)
+                          hint=_ZERO_DELAY_HINT)
     array = as_result_array(output, name, (6, 3), "z*, the compensated estimates")
     if array.shape == (0, 3):
         raise CheckFailed(f"{name} returns an empty array when delay_steps = 0. "

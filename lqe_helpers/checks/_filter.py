@@ -243,7 +243,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
         inputs = [array.copy() for array in m.args]
         try:
             output = call_student(my_filter, name, tuple(inputs), m.describe(),
-                           shape_hint=_FILTER_SHAPE_HINT)
+                                  shape_hint=_FILTER_SHAPE_HINT)
         except NotWrittenYet:
             raise
         except CheckFailed as failure:
@@ -262,7 +262,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
         passed(f"{name} matches eq. (5) on {len(models)} random models (1–4 states, 1–3 "
-                f"sensors, {_FILTER_STEPS} steps) to {tolerance_text(FUNCTION_RTOL)}")
+               f"sensors, {_FILTER_STEPS} steps) to {tolerance_text(FUNCTION_RTOL)}")
         return
 
     mistake = match_mistake(_FILTER_MISTAKES, _filter_result, answers, correct)

@@ -42,7 +42,7 @@ def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -
     _check_fusion_C(C)
     _check_fusion_R(R, sigma_v, sigma_p)
     passed(f"C (2 × 3) reads the position p for vision and for proprioception, and "
-            f"R = diag(σ_v², σ_p²) = diag({sigma_v**2:g}, {sigma_p**2:g}) cm² (2 × 2)")
+           f"R = diag(σ_v², σ_p²) = diag({sigma_v**2:g}, {sigma_p**2:g}) cm² (2 × 2)")
 
 
 def _check_fusion_C(C: np.ndarray) -> None:

@@ -85,8 +85,8 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
              if not close(array, model.transition_matrix(dt), MATRIX_RTOL)]
     if not wrong:
         passed(f"{name} gives eq. (4)'s A (constant acceleration) at {len(answers)} time "
-                f"steps from {min(_TRANSITION_DTS):g} to {max(_TRANSITION_DTS):g} s, to "
-                f"{tolerance_text(MATRIX_RTOL)}")
+               f"steps from {min(_TRANSITION_DTS):g} to {max(_TRANSITION_DTS):g} s, to "
+               f"{tolerance_text(MATRIX_RTOL)}")
         return
     first, last = answers[_TRANSITION_DTS[0]], answers[_TRANSITION_DTS[-1]]
     if len(wrong) < len(answers) and np.allclose(first, last) and not np.allclose(
@@ -167,8 +167,9 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
     for P, F, G, sigma in _covariance_cases():
         inputs = (P.copy(), F.copy(), G.copy(), sigma)
         where = f"P and F of shape {P.shape}, G of shape {G.shape}, sigma = {sigma:.3g}"
-        output = call_student(predict_covariance, name, inputs, where,
-                       shape_hint="P and F are (k, k), G is (k, r): write each term's shape.")
+        output = call_student(
+            predict_covariance, name, inputs, where,
+            shape_hint="P and F are (k, k), G is (k, r): write each term's shape.")
         for label, given, original in zip(("P", "F", "G"), inputs, (P, F, G), strict=False):
             if not np.array_equal(given, original):
                 raise CheckFailed(f"{name} changed its input {label} in place ({where}); "
@@ -182,8 +183,8 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
             wrong.append((array, P, F, G, sigma, where))
     if not wrong:
         passed(f"{name} gives F P Fᵀ + G σ² Gᵀ (Lesson 0.5 eq. (9)) on "
-                f"{len(_COVARIANCE_CASES)} random cases (1–4 states, 1–2 inputs), to "
-                f"{tolerance_text(MATRIX_RTOL)}")
+               f"{len(_COVARIANCE_CASES)} random cases (1–4 states, 1–2 inputs), to "
+               f"{tolerance_text(MATRIX_RTOL)}")
         return
     for key in ("sides", "no_noise", "sigma", "no_transpose", "not_moved"):
         if all(close(array, _covariance_mistakes(P, F, G, sigma)[key][0], MATRIX_RTOL)
@@ -238,7 +239,7 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
                           f"single input; got shape {G.shape}")
     if not close(F, right_F, MATRIX_RTOL):
         if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and close(F[:2, 2], -right_F[:2, 2],
-                                                                      MATRIX_RTOL):
+                                                                  MATRIX_RTOL):
             raise CheckFailed(
                 "F's last column adds the bias; the reading a_r = a + b carries the bias, so "
                 "the model must remove its estimate: the entries are −Δt²/2 and −Δt")
@@ -275,4 +276,4 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
                               "3 × 3")
         raise CheckFailed("Q is not G σ_a² Gᵀ (Lesson 0.5 eq. (9)) for the given σ_a")
     passed(f"F, G and Q = G σ_a² Gᵀ match Lesson 0.5 eqs. (5), (9) for Δt = {dt:g} s and "
-            f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")
+           f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")

@@ -130,11 +130,11 @@ def check_mse(value: float | np.ndarray, estimate: np.ndarray, truth: np.ndarray
     if got.shape == expected.shape and same(got, expected):
         what = f"{runs} MSEs (one per run)" if runs else "MSE"
         passed(f"{what} match{'es' * (not runs)} metrics.mse (positions, {skipped}) to "
-                f"rtol {tolerance_text(MSE_RTOL)}")
+               f"rtol {tolerance_text(MSE_RTOL)}")
         return
     if runs and got.ndim == 0 and same(got, np.mean(expected)):
         passed(f"mean MSE over {runs} runs matches metrics.mse (positions, {skipped}) to "
-                f"rtol {tolerance_text(MSE_RTOL)}")
+               f"rtol {tolerance_text(MSE_RTOL)}")
         return
     if got.shape != expected.shape and not (runs and got.ndim == 0):
         raise CheckFailed(
@@ -262,8 +262,8 @@ def check_convergence_time(value: float, squared_error: np.ndarray, dt: float,
         raise CheckFailed(f"your convergence time must be a finite number of seconds, got {got}")
     if same(got, expected):
         passed(f"convergence time matches the pack's definition (first time after which "
-                f"{mean_of} stays within {factor:g} × its second-half level) to "
-                f"{tolerance_text(TIME_ATOL)} s")
+               f"{mean_of} stays within {factor:g} × its second-half level) to "
+               f"{tolerance_text(TIME_ATOL)} s")
         return
     single_run = ("your convergence time is that of a single run ({}). The definition "
                   "applies to the Monte Carlo mean: average the squared errors over the "
@@ -372,8 +372,8 @@ def check_paired_difference(interval: metrics.Interval, mse_first: np.ndarray,
 
     if same((expected.mean, expected.low, expected.high)):
         passed(f"paired difference: mean and 95 % interval match metrics.mean_ci95 of "
-                f"mse_first − mse_second over {runs} runs (to {tolerance_text(INTERVAL_RTOL)} "
-                f"relative)")
+               f"mse_first − mse_second over {runs} runs (to {tolerance_text(INTERVAL_RTOL)} "
+               f"relative)")
         return
     t = metrics.t_critical_95(runs - 1)
     s = float(np.std(difference, ddof=1))
