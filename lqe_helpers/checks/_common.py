@@ -131,12 +131,14 @@ def as_result_array(output: object, name: str, expected: tuple[int, ...],
 
 def match_mistake(mistakes: dict[str, str], compute: Callable[[str, int], np.ndarray | None],
                   answers: dict[int, np.ndarray], correct: dict[int, np.ndarray],
-                  rows: Callable[[int], slice] | None = None) -> str | None:
+                  rows: Callable[[int, np.ndarray], np.ndarray] | None = None) -> str | None:
     """The first mistake whose result equals the student's answer on every model it can run.
 
     ``answers`` maps model index → the student's (right-shaped) result; ``compute(mistake,
     index)`` gives the mistaken result or None. A mistake counts only if it differs from
     the correct result on at least one model, so it really explains the wrong answer.
+    ``rows(index, wrong)``, if given, is a boolean mask of the rows to compare; a model
+    where it selects none is skipped.
     """
     for mistake in mistakes:
         explained = False
@@ -145,7 +147,9 @@ def match_mistake(mistakes: dict[str, str], compute: Callable[[str, int], np.nda
             wrong = compute(mistake, index)
             if wrong is None:
                 continue
-            part = rows(index) if rows is not None else slice(None)
+            part = rows(index, wrong) if rows is not None else slice(None)
+            if rows is not None and not np.any(part):
+                continue
             if not close(answer[part], wrong[part], MISTAKE_RTOL):
                 consistent = False
                 break

@@ -10,12 +10,12 @@ import numpy as np
 from .. import reference
 from ._common import (
     FUNCTION_RTOL,
-    MISTAKE_RTOL,
     SEED,
     CheckFailed,
     as_result_array,
     call_student,
     close,
+    match_mistake,
     passed,
     require_callable,
     tolerance_text,
@@ -153,7 +153,14 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
             case = cases[index]
             return _compensation_mistake(mistake, case.estimates, case.A, case.delay)
 
-        mistake = _match_core(compute, answers, correct, core)
+        def defined_core_rows(index: int, wrong: np.ndarray) -> np.ndarray:
+            """The rows after the first δ + 1 where the mistake gives a value."""
+            defined = np.all(np.isfinite(wrong), axis=1)
+            defined[: core(index).start] = False
+            return defined
+
+        mistake = match_mistake(_COMPENSATION_MISTAKES, compute, answers, correct,
+                                rows=defined_core_rows)
         if mistake is not None:
             raise CheckFailed(
                 f"{name} does not follow eq. (7): {_COMPENSATION_MISTAKES[mistake]}.")
@@ -178,31 +185,6 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
     passed(f"{name} matches eq. (7) (z*_j = A^δ ẑ_(j−δ), NaN before δ) on "
            f"{len(cases)} random cases (1–4 states, δ = 1–4) and with δ = 0, to "
            f"{tolerance_text(FUNCTION_RTOL)}")
-
-
-def _match_core(compute: Callable[[str, int], np.ndarray | None],
-                answers: dict[int, np.ndarray], correct: dict[int, np.ndarray],
-                core: Callable[[int], slice]) -> str | None:
-    """Like :func:`match_mistake`, comparing only the rows a mistake gives a value for."""
-    for mistake in _COMPENSATION_MISTAKES:
-        explained, consistent = False, True
-        for index, answer in answers.items():
-            wrong = compute(mistake, index)
-            if wrong is None:
-                continue
-            rows = core(index)
-            defined = np.all(np.isfinite(wrong), axis=1)
-            defined[: rows.start] = False
-            if not defined.any():
-                continue
-            if not close(answer[defined], wrong[defined], MISTAKE_RTOL):
-                consistent = False
-                break
-            if not close(correct[index][defined], wrong[defined], MISTAKE_RTOL):
-                explained = True
-        if consistent and explained:
-            return mistake
-    return None
 
 
 def _run_compensation(compensate: Callable, name: str, case: _CompensationCase) -> np.ndarray:
