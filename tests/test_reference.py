@@ -13,9 +13,10 @@ import textwrap
 
 import numpy as np
 import pytest
+import reference_loops as reference
 from filterpy.kalman import KalmanFilter
 
-from lqe_helpers import model, prediction, reference, scenario, simulation
+from lqe_helpers import model, prediction, scenario, simulation
 from lqe_helpers.filter import kalman_filter
 
 ENGINE_RTOL = 1e-10
