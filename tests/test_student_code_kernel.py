@@ -119,7 +119,7 @@ def test_the_time_limit_stops_an_endless_loop_in_the_kernel(executed) -> None:
 def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     notebook, folder = executed
     assert "".join(output.text for output in notebook.cells[6].outputs) == (
-        "saved doubled to my_functions/doubled.py; later notebooks load it from there\n42\n")
+        "doubled is saved in my_functions/doubled.py; later notebooks load it from there\n42\n")
     name, shown = error_of(notebook.cells[7])
     assert name == "StudentCodeError"
     assert shown.rstrip().endswith(

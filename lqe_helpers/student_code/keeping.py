@@ -66,8 +66,8 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
     The function's source (as written in its notebook cell) is written, after the
     header line :data:`SAVE_HEADER` and ``import numpy as np``, through a temporary file
     and ``os.replace``. A file of that name without the header (written by hand) is never
-    replaced; a file that already holds the same text is left untouched. Prints one line
-    saying what it did.
+    replaced; a file that already holds the same text is left untouched. Prints one line,
+    the same whether or not the file changed (a notebook's output does not depend on it).
 
     Parameters
     ----------
@@ -138,11 +138,9 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
                 f"it is left as it is: rename or delete it, then run this cell again")
     else:
         old = None
-    if old == text:
-        print(f"{shown} already holds this {name}")
-    else:
+    if old != text:
         _write(path, text)
-        print(f"saved {name} to {shown}; later notebooks load it from there")
+    print(f"{name} is saved in {shown}; later notebooks load it from there")
     return load(name, path.parent)
 
 
