@@ -159,4 +159,23 @@ def test_the_package_holds_no_readable_worked_answer() -> None:
     assert not (package / "reference.py").exists()
     for path in package.rglob("*.py"):
         text = path.read_text("utf-8")
-        assert "reference_loops" not in text and "lqe_helpers.reference" not in text, path
+        assert "import reference_loops" not in text, path
+        assert "lqe_helpers.reference" not in text and "import reference\n" not in text, path
+
+
+def test_the_student_pack_holds_no_worked_answer_of_01_or_05() -> None:
+    """Neither the oracle, nor the checks' tests, nor the worked notebooks' saved functions."""
+    from pathlib import Path
+
+    from lqe_helpers.authoring import student_pack
+
+    root = Path(__file__).resolve().parents[1]
+    assert (root / "notebooks" / "my_functions" / "my_filter.py").is_file()
+    files = student_pack.pack_contents(root)
+    assert not [name for name in files if "my_functions" in name or "reference_loops" in name
+                or name in ("tests/test_checks_vision.py", "tests/test_checks_delay.py")]
+    worked_lines = ("z = A @ z + K @ (y_j - C @ A @ z)",
+                    "z_star[j] = A_delta @ estimates[j - delay_steps]")
+    for name, data in files.items():
+        text = data.decode("utf-8", errors="replace")
+        assert not [line for line in worked_lines if line in text], name
