@@ -307,6 +307,7 @@ def test_save_writes_the_source_and_returns_the_function_loaded_back(tmp_path, c
     text = (folder / "doubled.py").read_text("utf-8")
     assert text.splitlines()[0] == student_code.SAVE_HEADER
     assert "import numpy as np\n\n\ndef doubled(x):\n    \"\"\"Twice x, as an array.\"\"\"" in text
+    assert (folder / "doubled.py").stat().st_mode & 0o777 == 0o644
     assert loaded is not doubled and loaded(21) == 42
     assert "SCALE" not in loaded.__globals__ and loaded.__globals__["np"] is np
     assert student_code.load("doubled", folder)(1) == 2

@@ -7,6 +7,7 @@ import builtins
 import inspect
 import linecache
 import os
+import stat
 import symtable
 import tempfile
 import textwrap
@@ -154,6 +155,9 @@ def _write(path: Path, text: str) -> None:
                                          delete=False) as handle:
             temporary = Path(handle.name)
             handle.write(text)
+        # A temporary file is private (0600); the saved one reads like any file the student
+        # writes (its old mode, or rw-r--r--).
+        os.chmod(temporary, stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o644)
         os.replace(temporary, path)
     except OSError as error:
         if temporary is not None:
