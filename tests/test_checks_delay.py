@@ -257,3 +257,11 @@ def test_check_delay_difference_judges_against_the_engine() -> None:
     gain = metrics.mean_ci95(batch.mse("delayed") - batch.mse("predicted"))
     assert_fails("does not match the paired difference delayed − compensated MSE",
                  checks.check_delay_difference, gain)
+
+
+def test_check_compensation_says_float32_keeps_too_few_digits() -> None:
+    def compensate(estimates, A, delay_steps):
+        return reference.compensate(estimates, A, delay_steps).astype(np.float32)
+
+    assert_fails("compensate returned float32 numbers, which keep only about 6 digits: compute "
+                 "in float64", checks.check_compensation, compensate)

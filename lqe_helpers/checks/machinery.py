@@ -122,10 +122,13 @@ def call_student(function: Callable, *args: object, name: str, where: str,
 def student_result(value: object, *, name: str, what: str,
                    shape: Sequence[int | None] | None = None, allow_nan: bool = False,
                    where: str = "") -> np.ndarray:
-    """``student_code.result_array`` for a check: a float array, or one CheckFailed."""
+    """``student_code.result_array`` for a check: a float64 array, or one CheckFailed.
+
+    Floats of less than double precision are refused: a function check compares to 1e-9.
+    """
     try:
         return student_code.result_array(value, name=name, what=what, shape=shape,
-                                         allow_nan=allow_nan, where=where)
+                                         allow_nan=allow_nan, double=True, where=where)
     except StudentCodeError as error:
         failure = CheckFailed(str(error))
     raise failure

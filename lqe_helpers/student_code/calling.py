@@ -160,6 +160,9 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     reports the time-out. Either way only Python code is interrupted: a single numpy call
     runs to its end.
 
+    These guard against a student's mistakes, not against deliberate cheating: code in the
+    same process that switches the timer off or reads the caller's frames is not stopped.
+
     Parameters
     ----------
     function : callable

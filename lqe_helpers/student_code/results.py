@@ -38,7 +38,8 @@ def _fits(shape: tuple[int, ...], wanted: Sequence[int | None]) -> bool:
 
 
 def array_problem(value: object, *, shape: Sequence[int | None] | None = None,
-                  allow_nan: bool = False, returned: bool = True) -> str | None:
+                  allow_nan: bool = False, returned: bool = True,
+                  double: bool = False) -> str | None:
     """Why ``value`` is not a real, finite number array of ``shape``, or None if it is.
 
     The answer is a phrase that completes "my_filter returned …" (``returned``) or
@@ -54,6 +55,9 @@ def array_problem(value: object, *, shape: Sequence[int | None] | None = None,
         Accept NaN ("no value", e.g. before a delayed signal arrives); inf never.
     returned : bool
         Word the advice for a returned value.
+    double : bool
+        Refuse floats of less than double precision (float32 keeps about 7 digits, too
+        few for a comparison to 1e-9).
 
     Returns
     -------
@@ -95,6 +99,10 @@ def array_problem(value: object, *, shape: Sequence[int | None] | None = None,
                     "rectangular array of numbers")
         if kind in _KIND_NAMES:
             return f"an array of {_KIND_NAMES[kind]}"
+        if double and kind == "f" and value.dtype.itemsize < 8:
+            return (f"{value.dtype} numbers, which keep only about "
+                    f"{np.finfo(value.dtype).precision} digits: compute in float64, NumPy's "
+                    f"default (leave out dtype=np.{value.dtype}, or .astype(...))")
         array = np.asarray(value, dtype=float)
     else:
         kind_name = type(value).__name__
@@ -124,6 +132,7 @@ def array_problem(value: object, *, shape: Sequence[int | None] | None = None,
 
 def result_array(value: object, *, name: str, what: str,
                  shape: Sequence[int | None] | None = None, allow_nan: bool = False,
+                 double: bool = False,
                  where: str = "") -> np.ndarray:
     """What a student's function returned, as a float array, or a StudentCodeError.
 
@@ -135,7 +144,7 @@ def result_array(value: object, *, name: str, what: str,
         The function's name for the message.
     what : str
         What it must return, with its shape ("the estimates ẑ, shape (n, k) = (15, 3)").
-    shape, allow_nan
+    shape, allow_nan, double
         See :func:`array_problem`.
     where : str
         What it was called on, for the message.
@@ -150,7 +159,7 @@ def result_array(value: object, *, name: str, what: str,
     StudentCodeError
         One line naming what was returned (:func:`array_problem`).
     """
-    problem = array_problem(value, shape=shape, allow_nan=allow_nan)
+    problem = array_problem(value, shape=shape, allow_nan=allow_nan, double=double)
     if problem is not None:
         on = f" (on {where})" if where else ""
         raise StudentCodeError(f"{name} returned {problem}; it must return {what}{on}")
