@@ -45,8 +45,8 @@ _GUARDED_NUMPY = ("numpy", "numpy.linalg")
 
 def _guarded_modules() -> list[types.ModuleType]:
     return [module for name, module in list(sys.modules.items())
-            if isinstance(module, types.ModuleType)
-            and (name.split(".")[0] == "lqe_helpers" or name in _GUARDED_NUMPY)]
+            if (name == "lqe_helpers" or name.startswith("lqe_helpers.")
+                or name in _GUARDED_NUMPY) and isinstance(module, types.ModuleType)]
 
 
 def _snapshot() -> dict[types.ModuleType, dict[str, object]]:
@@ -56,16 +56,16 @@ def _snapshot() -> dict[types.ModuleType, dict[str, object]]:
 def _restore(before: dict[types.ModuleType, dict[str, object]]) -> list[str]:
     """Put back attributes of the guarded modules that were replaced or deleted.
 
-    Returns their names. New attributes (a submodule imported on first use) are left.
+    Returns their names. New attributes (a submodule imported on first use) are left, and
+    so are dunder names (``__warningregistry__`` and the like change on their own).
     """
     changed = []
     for module, names in before.items():
         now = vars(module)
-        for key, value in names.items():
-            if key.startswith("__") or now.get(key, _MISSING) is value:
-                continue
-            changed.append(f"{module.__name__}.{key}")
-            setattr(module, key, value)
+        for key in [key for key, value in names.items() if now.get(key, _MISSING) is not value]:
+            if not key.startswith("__"):
+                changed.append(f"{module.__name__}.{key}")
+                setattr(module, key, names[key])
     return sorted(changed)
 
 
