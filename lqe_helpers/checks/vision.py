@@ -242,7 +242,7 @@ def _by_sigma(values: object, name: str, what: str) -> dict[float, object]:
     if missing:
         have = ", ".join(repr(key) for key in values) or "none"
         raise CheckFailed(f"{name} has no entry for σ_v = {missing[0]:g} cm (its keys: "
-                          f"{have}); Task 2 asks for both noise levels, keyed by the number "
+                          f"{have}); the task asks for both noise levels, keyed by the number "
                           f"σ_v itself")
     return keys
 
