@@ -11,19 +11,20 @@ import pytest
 from lqe_helpers.checks import CheckFailed
 
 
-def assert_passes(capsys: pytest.CaptureFixture[str], check, *args) -> str:
+def assert_passes(capsys: pytest.CaptureFixture[str], check, *args, **kwargs) -> str:
     """Run a check that must pass; return its single output line."""
-    check(*args)
+    check(*args, **kwargs)
     lines = capsys.readouterr().out.splitlines()
     assert len(lines) == 1, lines
     assert lines[0].startswith("✓ ")
     return lines[0]
 
 
-def assert_fails(phrase: str, check, *args) -> str:
-    """Run a check that must fail with ``phrase`` in its message; return the message."""
+def assert_fails(phrase: str, check, *args, **kwargs) -> str:
+    """Run a check that must fail with ``phrase`` in its one-line message; return the message."""
     with pytest.raises(CheckFailed) as info:
-        check(*args)
+        check(*args, **kwargs)
     message = str(info.value)
     assert phrase in message, message
+    assert "\n" not in message, message
     return message

@@ -1,4 +1,4 @@
-"""The readable worked solutions of :mod:`lqe_helpers.reference` against independent results.
+"""The test oracle ``reference_loops`` (readable eq. (5) and (7)) against independent results.
 
 Tolerance of "the fast engine equals the reference": every estimate within
 1e-10 × (the largest |estimate| of the run, at least 1), i.e. relative to the run's scale,
@@ -13,9 +13,10 @@ import textwrap
 
 import numpy as np
 import pytest
+import reference_loops as reference
 from filterpy.kalman import KalmanFilter
 
-from lqe_helpers import model, prediction, reference, scenario, simulation
+from lqe_helpers import model, prediction, scenario, simulation
 from lqe_helpers.filter import kalman_filter
 
 ENGINE_RTOL = 1e-10
@@ -92,7 +93,7 @@ def test_reference_hand_derived_scalar_case() -> None:
 
 
 def test_reference_filter_is_a_short_readable_loop() -> None:
-    """The worked solution students see: about 15 lines of code, one per line of eq. (5)."""
+    """The oracle stays a plain loop: about 15 lines of code, one per line of eq. (5)."""
     source = textwrap.dedent(inspect.getsource(reference.lqe_filter))
     body = ast.parse(source).body[0].body
     code = [node for node in body
@@ -148,3 +149,33 @@ def test_compensate_refuses_bad_input() -> None:
         reference.compensate(np.zeros((4, 2)), np.eye(3), 1)
     with pytest.raises(ValueError, match=r"estimates must have shape \(n, k\)"):
         reference.compensate(np.zeros((2, 4, 2)), np.eye(2), 1)
+
+
+def test_the_package_holds_no_readable_worked_answer() -> None:
+    """The loops answer tasks of 01 and 05: nothing in lqe_helpers imports or holds them."""
+    from pathlib import Path
+
+    package = Path(__file__).resolve().parents[1] / "lqe_helpers"
+    assert not (package / "reference.py").exists()
+    for path in package.rglob("*.py"):
+        text = path.read_text("utf-8")
+        assert "import reference_loops" not in text, path
+        assert "lqe_helpers.reference" not in text and "import reference\n" not in text, path
+
+
+def test_the_student_pack_holds_no_worked_answer_of_01_or_05() -> None:
+    """Neither the oracle, nor the checks' tests, nor the worked notebooks' saved functions."""
+    from pathlib import Path
+
+    from lqe_helpers.authoring import student_pack
+
+    root = Path(__file__).resolve().parents[1]
+    assert (root / "notebooks" / "my_functions" / "my_filter.py").is_file()
+    files = student_pack.pack_contents(root)
+    assert not [name for name in files if "my_functions" in name or "reference_loops" in name
+                or name in ("tests/test_checks_vision.py", "tests/test_checks_delay.py")]
+    worked_lines = ("z = A @ z + K @ (y_j - C @ A @ z)",
+                    "z_star[j] = A_delta @ estimates[j - delay_steps]")
+    for name, data in files.items():
+        text = data.decode("utf-8", errors="replace")
+        assert not [line for line in worked_lines if line in text], name

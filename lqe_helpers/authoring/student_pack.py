@@ -63,7 +63,12 @@ INSTRUCTOR_PACKAGES = ("authoring",)
 #: Tests (files or folders under tests/) of the instructor's side, left out of the pack.
 INSTRUCTOR_TESTS = ("browser", "test_notebook_files.py", "test_student_edition.py",
                     "test_student_leaks.py", "test_student_pack.py", "test_marking_guide.py",
-                    "test_handouts.py", "test_notebook_runner.py")
+                    "test_handouts.py", "test_notebook_runner.py",
+                    # worked answers of tasks: the eq. (5)/(7) oracle and the checks' tests
+                    "reference_loops.py", "test_reference.py", "test_checks_background.py",
+                    "test_checks_vision.py", "test_checks_initial_covariance.py",
+                    "test_checks_fusion.py", "test_checks_numbers.py", "test_checks_delay.py",
+                    "test_checks_bias.py")
 #: A test that mentions these needs what the pack leaves out (authoring, worked notebooks).
 INSTRUCTOR_ONLY = re.compile(r"lqe_helpers\.authoring|from lqe_helpers import authoring"
                              r"|[\"']notebooks[\"']")

@@ -1,25 +1,36 @@
 """Instant feedback for the tasks of the notebooks: one ``check_…`` after each task.
 
-A check that passes prints one line starting with "✓ " saying what was verified. A check
-that fails raises :class:`CheckFailed` (an ``AssertionError``, so "Run All" stops at the
-wrong step) with a message that says what is wrong without giving the code.
+A check that passes prints one line starting with "✓ " saying what was verified and to
+what tolerance. A check that fails raises :class:`CheckFailed` (an ``AssertionError``, so
+"Run All" stops at the wrong step) with one message that says what is wrong, and names
+the likely cause, without giving the code; Jupyter shows it under the student's own cell
+with no library source.
 
-Function checks (:func:`check_filter`, :func:`check_compensation`) call the student's
-function on several small random models drawn from a fixed seed, not only on the pack's
-scenario, so that a hard-coded answer cannot pass. When the answer is wrong they compare
-it with typical mistakes computed here (kept private) to name the mistake.
+Function checks (:func:`check_filter`, :func:`check_compensation`, ...) call the student's
+function through :func:`lqe_helpers.student_code.call` (copies of the inputs, a time
+limit) on several small random models drawn from a fixed seed, so that a hard-coded answer
+cannot pass, and compare with the pack's engine, computed before the student's code runs.
+Number checks recompute what the task asks from the task's own inputs and draws and judge
+the student's value with :func:`judging.judge` against a catalogue of likely mistakes.
 
-One module per kind of task; this package re-exports what notebooks call:
+One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
+every ``check_…`` and the tolerances:
 
-- ``_common``: :class:`CheckFailed`, the tolerances, calling and comparing answers;
-- ``_filter``: (a) the filter of eq. (5);
-- ``_fusion``: (c) C and R for two senses;
-- ``_compensation``: (e) the delay compensation;
-- ``_numbers``: the numbers a task produces (P0, MSEs, convergence times, intervals);
-- ``_model``: notebooks 00 and 06 (A, the covariance step, the bias model).
+- ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
+  (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
+- ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
+  validating what a student passes;
+- ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
+  mistakes of an MSE and of a paired difference;
+- ``numbers``: the number checks several notebooks share until they have their own.
 """
 
-from ._common import (
+from .background import check_covariance_step, check_transition_matrix
+from .bias import check_bias_model
+from .delay import check_compensation, check_delay_difference, check_delay_mse
+from .fusion import check_fusion
+from .initial_covariance import check_convergence_time, check_initial_covariance
+from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
     MATRIX_RTOL,
@@ -28,16 +39,8 @@ from ._common import (
     TIME_ATOL,
     CheckFailed,
 )
-from ._compensation import check_compensation
-from ._filter import check_filter
-from ._fusion import check_fusion
-from ._model import check_bias_model, check_covariance_step, check_transition_matrix
-from ._numbers import (
-    check_convergence_time,
-    check_initial_covariance,
-    check_mse,
-    check_paired_difference,
-)
+from .numbers import check_mse, check_paired_difference
+from .vision import check_filter, check_vision_difference, check_vision_mse
 
 __all__ = [
     "FUNCTION_RTOL",
@@ -51,10 +54,14 @@ __all__ = [
     "check_compensation",
     "check_convergence_time",
     "check_covariance_step",
+    "check_delay_difference",
+    "check_delay_mse",
     "check_filter",
     "check_fusion",
     "check_initial_covariance",
     "check_mse",
     "check_paired_difference",
     "check_transition_matrix",
+    "check_vision_difference",
+    "check_vision_mse",
 ]

@@ -1,16 +1,12 @@
-"""The check of task (c): C and R for vision and proprioception."""
+"""Checks of notebook 03, question (c): C and R for vision and proprioception."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from ._common import (
-    MATRIX_RTOL,
-    CheckFailed,
-    matrix_argument,
-    passed,
-    positive_number,
-)
+from .machinery import MATRIX_RTOL, CheckFailed, argument_array, passed, positive_number
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
 
 def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
@@ -37,8 +33,8 @@ def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -
     """
     sigma_v = positive_number(sigma_v, "sigma_v", "cm")
     sigma_p = positive_number(sigma_p, "sigma_p", "cm")
-    C = matrix_argument(C, "C")
-    R = matrix_argument(R, "R")
+    C = argument_array(C, "C", "the observation matrix, an array of shape (2, 3)")
+    R = argument_array(R, "R", "the noise covariance (cm²), an array of shape (2, 2)")
     _check_fusion_C(C)
     _check_fusion_R(R, sigma_v, sigma_p)
     passed(f"C (2 × 3) reads the position p for vision and for proprioception, and "

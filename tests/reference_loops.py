@@ -1,16 +1,21 @@
-"""Worked solutions students see: the tutorial's equations as plain, readable loops.
+"""A test oracle: the tutorial's eqs. (5) and (7) as plain, readable loops.
 
-These are deliberately simple: one line of code per line of the tutorial, no batch axes,
-no numerical refinements. The pack's fast engine, :func:`lqe_helpers.filter.kalman_filter`,
-computes the same numbers (``tests/test_reference.py`` checks agreement to 1e-10) and
-is what the notebooks use for Monte Carlo runs.
+Deliberately simple: one line of code per line of the tutorial, no batch axes, no
+numerical refinements. The pack's fast engine (:func:`lqe_helpers.filter.kalman_filter`,
+:func:`lqe_helpers.prediction.predict_ahead`) is tested equal to these to 1e-10
+(``tests/test_reference.py``), and the checks' tests use them as the worked answers.
+
+These loops answer tasks of notebooks 01 and 05, so they live here, outside the package,
+and stay out of the student pack (``INSTRUCTOR_TESTS`` in
+``lqe_helpers/authoring/student_pack.py``). Imported by tests as ``reference_loops``
+(pytest puts ``tests/`` on ``sys.path``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from . import validation
+from lqe_helpers import validation
 
 
 def lqe_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,

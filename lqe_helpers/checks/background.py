@@ -1,4 +1,4 @@
-"""Checks of notebooks 00 and 06: A, the covariance step of eq. (9), the bias model."""
+"""Checks of notebook 00, the background: A of eq. (4) and the covariance step of eq. (9)."""
 
 from __future__ import annotations
 
@@ -7,20 +7,21 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .. import bias_model, model
-from ._common import (
+from .. import model
+from .machinery import (
     MATRIX_RTOL,
     SEED,
     CheckFailed,
-    as_result_array,
     call_student,
     close,
-    matrix_argument,
     passed,
-    positive_number,
     require_callable,
+    student_result,
+    time_limit_text,
     tolerance_text,
 )
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
 #: Time steps (s) at which :func:`check_transition_matrix` calls the student's function:
 #: the pack's own, and others (some > 1 s, where Δt, Δt² and Δt²/2 all differ clearly).
@@ -72,21 +73,22 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
         half, no acceleration term, an answer that ignores Δt, ...).
     """
     name = require_callable(make_A, "make_A", "check_transition_matrix")
+    right = {dt: model.transition_matrix(dt) for dt in _TRANSITION_DTS}
     answers = {}
     for dt in _TRANSITION_DTS:
-        output = call_student(make_A, name, (dt,), f"dt = {dt:g} s")
-        array = as_result_array(output, name, (3, 3), "the transition matrix A")
+        output = call_student(make_A, dt, name=name, where=f"dt = {dt:g} s", arg_names=("dt",))
+        array = student_result(output, name=name, where=f"dt = {dt:g} s",
+                               what="the transition matrix A, an array of shape (3, 3)")
         if array.shape != (3, 3):
             raise CheckFailed(
                 f"{name}({dt:g}) returned shape {array.shape}; A must be 3 × 3, one row and "
                 f"one column per state (p, v, a)")
         answers[dt] = array
-    wrong = [dt for dt, array in answers.items()
-             if not close(array, model.transition_matrix(dt), MATRIX_RTOL)]
+    wrong = [dt for dt, array in answers.items() if not close(array, right[dt], MATRIX_RTOL)]
     if not wrong:
         passed(f"{name} gives eq. (4)'s A (constant acceleration) at {len(answers)} time "
                f"steps from {min(_TRANSITION_DTS):g} to {max(_TRANSITION_DTS):g} s, to "
-               f"{tolerance_text(MATRIX_RTOL)}")
+               f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}")
         return
     first, last = answers[_TRANSITION_DTS[0]], answers[_TRANSITION_DTS[-1]]
     if len(wrong) < len(answers) and np.allclose(first, last) and not np.allclose(
@@ -163,28 +165,26 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
         sides, no noise term, σ instead of σ², no transpose, P not moved by F).
     """
     name = require_callable(predict_covariance, "predict_covariance", "check_covariance_step")
+    cases = _covariance_cases()
+    right = [F @ P @ F.T + sigma**2 * G @ G.T for P, F, G, sigma in cases]
     wrong = []
-    for P, F, G, sigma in _covariance_cases():
-        inputs = (P.copy(), F.copy(), G.copy(), sigma)
+    for (P, F, G, sigma), expected in zip(cases, right, strict=True):
         where = f"P and F of shape {P.shape}, G of shape {G.shape}, sigma = {sigma:.3g}"
         output = call_student(
-            predict_covariance, name, inputs, where,
+            predict_covariance, P, F, G, sigma, name=name, where=where,
+            arg_names=("P", "F", "G", "sigma"),
             shape_hint="P and F are (k, k), G is (k, r): write each term's shape.")
-        for label, given, original in zip(("P", "F", "G"), inputs, (P, F, G), strict=False):
-            if not np.array_equal(given, original):
-                raise CheckFailed(f"{name} changed its input {label} in place ({where}); "
-                                  f"return a new matrix instead")
-        array = as_result_array(output, name, P.shape, "the new covariance P")
+        array = student_result(output, name=name, where=where,
+                               what=f"the new covariance P, an array of shape {P.shape}")
         if array.shape != P.shape:
             raise CheckFailed(f"{name} returned shape {array.shape} for {where}; the new "
                               f"covariance has the shape of P, {P.shape}")
-        right = F @ P @ F.T + sigma**2 * G @ G.T
-        if not close(array, right, MATRIX_RTOL):
+        if not close(array, expected, MATRIX_RTOL):
             wrong.append((array, P, F, G, sigma, where))
     if not wrong:
         passed(f"{name} gives F P Fᵀ + G σ² Gᵀ (Lesson 0.5 eq. (9)) on "
                f"{len(_COVARIANCE_CASES)} random cases (1–4 states, 1–2 inputs), to "
-               f"{tolerance_text(MATRIX_RTOL)}")
+               f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}")
         return
     for key in ("sides", "no_noise", "sigma", "no_transpose", "not_moved"):
         if all(close(array, _covariance_mistakes(P, F, G, sigma)[key][0], MATRIX_RTOL)
@@ -194,86 +194,3 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
     raise CheckFailed(
         f"{name} does not give F P Fᵀ + G σ² Gᵀ on {wrong[0][5]}, and not by one of the "
         f"usual mistakes")
-
-
-def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
-                     sigma_a: float) -> None:
-    """Check F, G and Q of the biased acceleration model (Lesson 0.5 eqs. (4), (5), (9)).
-
-    Expected, for the state [p, v, b] and the input u = a_r (cm/s²):
-    ``F = [[1, Δt, −Δt²/2], [0, 1, −Δt], [0, 0, 1]]``, ``G = [Δt²/2, Δt, 0]ᵀ`` (shape
-    (3, 1)) and ``Q = G σ_a² Gᵀ``, each within :data:`MATRIX_RTOL`
-    (:mod:`lqe_helpers.bias_model`).
-
-    Parameters
-    ----------
-    F : array_like, shape (3, 3)
-    G : array_like, shape (3, 1)
-    Q : array_like, shape (3, 3)
-        The student's matrices.
-    dt : float
-        The time step they were built for (s), > 0.
-    sigma_a : float
-        The signal's noise they were built for (cm/s²), > 0.
-
-    Raises
-    ------
-    CheckFailed
-        With the mistake named: shapes, the bias added instead of removed, Δt² without
-        the half, a row for the bias in G, σ_a instead of σ_a², ...
-    """
-    dt = positive_number(dt, "dt", "s")
-    sigma_a = positive_number(sigma_a, "sigma_a", "cm/s²")
-    F = matrix_argument(F, "F")
-    G = matrix_argument(G, "G")
-    Q = matrix_argument(Q, "Q")
-    right_F = bias_model.transition_matrix(dt)
-    right_G = bias_model.input_matrix(dt)
-    if F.shape != (3, 3):
-        raise CheckFailed(f"F must be 3 × 3 (state [p, v, b]), got shape {F.shape}")
-    if G.shape == (3,):
-        raise CheckFailed("G has shape (3,): make it a column, shape (3, 1), so that G σ² Gᵀ "
-                          "is a 3 × 3 matrix")
-    if G.shape != (3, 1):
-        raise CheckFailed(f"G must have shape (3, 1): one row per state, one column for the "
-                          f"single input; got shape {G.shape}")
-    if not close(F, right_F, MATRIX_RTOL):
-        if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and close(F[:2, 2], -right_F[:2, 2],
-                                                                  MATRIX_RTOL):
-            raise CheckFailed(
-                "F's last column adds the bias; the reading a_r = a + b carries the bias, so "
-                "the model must remove its estimate: the entries are −Δt²/2 and −Δt")
-        if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and np.allclose(F[:2, 2], 0):
-            raise CheckFailed(
-                "F's last column does not correct for the bias (zeros above the diagonal): "
-                "the bias estimate must be subtracted from the reading, −Δt²/2 and −Δt")
-        if close(F[0, 2], -dt**2, MATRIX_RTOL) or close(F[0, 2], dt**2, MATRIX_RTOL):
-            raise CheckFailed("F[0, 2] holds Δt²; the position integrates the acceleration "
-                              "over a step with Δt²/2")
-        raise CheckFailed(
-            "F is not Lesson 0.5 eq. (5)'s transition matrix for [p, v, b]: p moves by Δt v "
-            "and by Δt²/2 times (reading − bias), v by Δt times it, b stays")
-    if not close(G, right_G, MATRIX_RTOL):
-        if close(G[:2], right_G[:2], MATRIX_RTOL):
-            raise CheckFailed("G's last entry must be 0: the reading does not change the bias")
-        if close(G[0], np.array([dt**2]), MATRIX_RTOL):
-            raise CheckFailed("G[0] holds Δt²; the position takes Δt²/2 of the reading")
-        raise CheckFailed("G is not Lesson 0.5 eq. (5)'s input matrix: the reading enters the "
-                          "position with Δt²/2, the velocity with Δt, the bias not at all")
-    right_Q = sigma_a**2 * right_G @ right_G.T
-    if Q.shape != (3, 3):
-        raise CheckFailed(f"Q must be 3 × 3, got shape {Q.shape}")
-    if not close(Q, right_Q, MATRIX_RTOL):
-        if close(Q, sigma_a * right_G @ right_G.T, MATRIX_RTOL):
-            raise CheckFailed("Q uses σ_a where its square belongs: Q = G σ_a² Gᵀ (variances, "
-                              "not standard deviations)")
-        if close(Q, sigma_a**2 * np.eye(3), MATRIX_RTOL) or close(
-                Q, sigma_a**2 * np.diag(right_G[:, 0]), MATRIX_RTOL):
-            raise CheckFailed("Q is not pushed through G: the signal's noise reaches the "
-                              "state the way the signal does, Q = G σ_a² Gᵀ")
-        if close(Q, sigma_a**2 * right_G.T @ right_G, MATRIX_RTOL):
-            raise CheckFailed("Q is built as Gᵀ G (one number); the covariance is G σ_a² Gᵀ, "
-                              "3 × 3")
-        raise CheckFailed("Q is not G σ_a² Gᵀ (Lesson 0.5 eq. (9)) for the given σ_a")
-    passed(f"F, G and Q = G σ_a² Gᵀ match Lesson 0.5 eqs. (5), (9) for Δt = {dt:g} s and "
-           f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")

@@ -1,0 +1,101 @@
+"""Checks of notebook 06, the bonus: F, G and Q of the biased acceleration model."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import bias_model
+from .machinery import (
+    MATRIX_RTOL,
+    CheckFailed,
+    argument_array,
+    close,
+    passed,
+    positive_number,
+    tolerance_text,
+)
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+
+def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
+                     sigma_a: float) -> None:
+    """Check F, G and Q of the biased acceleration model (Lesson 0.5 eqs. (4), (5), (9)).
+
+    Expected, for the state [p, v, b] and the input u = a_r (cm/s²):
+    ``F = [[1, Δt, −Δt²/2], [0, 1, −Δt], [0, 0, 1]]``, ``G = [Δt²/2, Δt, 0]ᵀ`` (shape
+    (3, 1)) and ``Q = G σ_a² Gᵀ``, each within :data:`MATRIX_RTOL`
+    (:mod:`lqe_helpers.bias_model`).
+
+    Parameters
+    ----------
+    F : array_like, shape (3, 3)
+    G : array_like, shape (3, 1)
+    Q : array_like, shape (3, 3)
+        The student's matrices.
+    dt : float
+        The time step they were built for (s), > 0.
+    sigma_a : float
+        The signal's noise they were built for (cm/s²), > 0.
+
+    Raises
+    ------
+    CheckFailed
+        With the mistake named: shapes, the bias added instead of removed, Δt² without
+        the half, a row for the bias in G, σ_a instead of σ_a², ...
+    """
+    dt = positive_number(dt, "dt", "s")
+    sigma_a = positive_number(sigma_a, "sigma_a", "cm/s²")
+    F = argument_array(F, "F", "the transition matrix, an array of shape (3, 3)")
+    G = argument_array(G, "G", "the input matrix, an array of shape (3, 1)")
+    Q = argument_array(Q, "Q", "the process noise covariance, an array of shape (3, 3)")
+    right_F = bias_model.transition_matrix(dt)
+    right_G = bias_model.input_matrix(dt)
+    if F.shape != (3, 3):
+        raise CheckFailed(f"F must be 3 × 3 (state [p, v, b]), got shape {F.shape}")
+    if G.shape == (3,):
+        raise CheckFailed("G has shape (3,): make it a column, shape (3, 1), so that G σ² Gᵀ "
+                          "is a 3 × 3 matrix")
+    if G.shape != (3, 1):
+        raise CheckFailed(f"G must have shape (3, 1): one row per state, one column for the "
+                          f"single input; got shape {G.shape}")
+    if not close(F, right_F, MATRIX_RTOL):
+        if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and close(F[:2, 2], -right_F[:2, 2],
+                                                                  MATRIX_RTOL):
+            raise CheckFailed(
+                "F's last column adds the bias; the reading a_r = a + b carries the bias, so "
+                "the model must remove its estimate: the entries are −Δt²/2 and −Δt")
+        if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and np.allclose(F[:2, 2], 0):
+            raise CheckFailed(
+                "F's last column does not correct for the bias (zeros above the diagonal): "
+                "the bias estimate must be subtracted from the reading, −Δt²/2 and −Δt")
+        if close(F[0, 2], -dt**2, MATRIX_RTOL) or close(F[0, 2], dt**2, MATRIX_RTOL):
+            raise CheckFailed("F[0, 2] holds Δt²; the position integrates the acceleration "
+                              "over a step with Δt²/2")
+        raise CheckFailed(
+            "F is not Lesson 0.5 eq. (5)'s transition matrix for [p, v, b]: p moves by Δt v "
+            "and by Δt²/2 times (reading − bias), v by Δt times it, b stays")
+    if not close(G, right_G, MATRIX_RTOL):
+        if close(G[:2], right_G[:2], MATRIX_RTOL):
+            raise CheckFailed("G's last entry must be 0: the reading does not change the bias")
+        if close(G[0], np.array([dt**2]), MATRIX_RTOL):
+            raise CheckFailed("G[0] holds Δt²; the position takes Δt²/2 of the reading")
+        raise CheckFailed("G is not Lesson 0.5 eq. (5)'s input matrix: the reading enters the "
+                          "position with Δt²/2, the velocity with Δt, the bias not at all")
+    right_Q = sigma_a**2 * right_G @ right_G.T
+    if Q.shape != (3, 3):
+        raise CheckFailed(f"Q must be 3 × 3, got shape {Q.shape}")
+    if not close(Q, right_Q, MATRIX_RTOL):
+        if close(Q, sigma_a * right_G @ right_G.T, MATRIX_RTOL):
+            raise CheckFailed("Q uses σ_a where its square belongs: Q = G σ_a² Gᵀ (variances, "
+                              "not standard deviations)")
+        if close(Q, sigma_a**2 * np.eye(3), MATRIX_RTOL) or close(
+                Q, sigma_a**2 * np.diag(right_G[:, 0]), MATRIX_RTOL):
+            raise CheckFailed("Q is not pushed through G: the signal's noise reaches the "
+                              "state the way the signal does, Q = G σ_a² Gᵀ")
+        if close(Q, sigma_a**2 * right_G.T @ right_G, MATRIX_RTOL):
+            raise CheckFailed("Q is built as Gᵀ G (one number); the covariance is G σ_a² Gᵀ, "
+                              "3 × 3")
+        raise CheckFailed("Q is not G σ_a² Gᵀ (Lesson 0.5 eq. (9)) for the given σ_a")
+    passed(f"F, G and Q = G σ_a² Gᵀ match Lesson 0.5 eqs. (5), (9) for Δt = {dt:g} s and "
+           f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")

@@ -1,0 +1,305 @@
+"""Judging a student's number against an independent recomputation, naming likely mistakes.
+
+A number check recomputes what the task asks from the task's own inputs and draws (the
+same seed, the pack's engine), before looking at the student's value, and hands both to
+:func:`judge` (a number or an array) or :func:`judge_interval` (a mean with its 95 %
+interval), with a catalogue of likely mistakes, each computed from the same inputs::
+
+    judge("mse_filtered[4.5]", value, expected, MSE_RTOL, unit="cm²",
+          what="the filtered estimate's MSE",
+          mistakes={"R holds σ_v where the variance σ_v² belongs ...": mse_with_r_sigma,
+                    **mse_mistakes(positions, truth, burn, dt)})
+
+The first mistake that matches the student's value (and not the right one) names the
+cause in the message, in words, without code. :func:`mse_mistakes` and
+:func:`interval_mistakes` give the mistakes every MSE and every paired difference can have.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+from .. import metrics
+from .machinery import CheckFailed, argument_array, tolerance_text
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+#: The normal distribution's two-sided 95 % point, the usual wrong stand-in for Student's t.
+NORMAL_95 = 1.959963984540054
+
+
+def _shown(value: np.ndarray, unit: str) -> str:
+    if value.ndim == 0:
+        return f" = {float(value):.6g}{f' {unit}' if unit else ''}"
+    return ""
+
+
+def judge(name: str, value: object, expected: object, rtol: float, *,
+          mistakes: Mapping[str, object] | None = None, unit: str = "",
+          what: str = "the value recomputed from the task's inputs", nan_hint: str = "",
+          hint: str = "") -> np.ndarray:
+    """Judge a student's number (or array) against an independent recomputation.
+
+    Parameters
+    ----------
+    name : str
+        The student's variable as they wrote it ("mse_filtered[4.5]").
+    value : object
+        The student's value: one real number (a size-1 array counts as one), or an array
+        of ``expected``'s shape.
+    expected : float or array_like
+        The right value, recomputed from the task's inputs before looking at ``value``.
+    rtol : float
+        Tolerance, relative to the largest entry of ``expected`` (stated by the caller in
+        its ✓ line).
+    mistakes : mapping of str to value, optional
+        Likely mistakes, in the order they are tried: the cause, in words for the
+        student, → the value that mistake gives on the task's inputs (None: cannot occur
+        here). A mistake that agrees with ``expected`` cannot explain a wrong value and
+        is skipped.
+    unit : str
+        Unit of the value, for messages ("cm²").
+    what : str
+        What the value is compared with, for the message when no mistake matches ("the
+        filtered MSE recomputed from the task's inputs").
+    nan_hint : str
+        Said when the value is NaN (e.g. "the first δ samples have no estimate yet").
+    hint : str
+        Added to the message when no mistake matches.
+
+    Returns
+    -------
+    ndarray
+        The student's value as a float array, if it agrees.
+
+    Raises
+    ------
+    CheckFailed
+        Naming ``name``: not a real number (array) of the right shape, NaN or infinite,
+        a matching mistake's cause, or that it does not match and not by a usual mistake.
+    """
+    expected = np.asarray(expected, dtype=float)
+    due = ("one number" if expected.ndim == 0 else f"an array of shape {expected.shape}") + (
+        f" ({unit})" if unit else "")
+    got = argument_array(value, name, due, allow_nan=True)
+    if expected.ndim == 0 and got.size == 1:
+        got = got.reshape(())
+    if got.shape != expected.shape:
+        raise CheckFailed(f"{name} must be {due}, got an array of shape {got.shape}")
+    if np.any(np.isnan(got)):
+        raise CheckFailed(f"{name} is NaN (not a number){f': {nan_hint}' if nan_hint else ''}")
+    scale = float(np.max(np.abs(expected))) if expected.size else 1.0
+
+    def near(a: np.ndarray, b: np.ndarray) -> bool:
+        size = max(scale, float(np.max(np.abs(b))) if b.size else 0.0) or 1.0
+        return bool(np.all(np.abs(a - b) <= rtol * size))
+
+    if near(got, expected):
+        return got
+    for cause, candidate in (mistakes or {}).items():
+        if candidate is None:
+            continue
+        wrong = np.asarray(candidate, dtype=float)
+        if wrong.shape != expected.shape or not np.all(np.isfinite(wrong)) or near(
+                wrong, expected):
+            continue
+        if near(got, wrong):
+            raise CheckFailed(f"{name}{_shown(got, unit)} is not right: {cause}")
+    raise CheckFailed(
+        f"{name}{_shown(got, unit)} does not match {what} (to {tolerance_text(rtol)} "
+        f"relative), and not by one of the usual mistakes{f': {hint}' if hint else ''}")
+
+
+def _interval_parts(interval: object, name: str) -> tuple[object, object, object]:
+    if all(hasattr(interval, part) for part in ("mean", "low", "high")):
+        return interval.mean, interval.low, interval.high
+    if isinstance(interval, (tuple, list)) and len(interval) == 2:
+        found = "a pair of numbers"
+    elif isinstance(interval, (int, float, np.number)) and not isinstance(interval, bool):
+        found = "a number"
+    elif isinstance(interval, np.ndarray):
+        found = f"an array of shape {interval.shape}"
+    else:
+        found = "None" if interval is None else f"a {type(interval).__name__}"
+    raise CheckFailed(
+        f"{name} is {found}; it must be the metrics.Interval that metrics.mean_ci95 returns "
+        f"(its mean, low and high), since a difference means little without its 95 % "
+        f"interval")
+
+
+def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol: float, *,
+                   mistakes: Mapping[str, metrics.Interval | None] | None = None,
+                   unit: str = "",
+                   what: str = "the paired difference recomputed from the task's inputs",
+                   nan_hint: str = "") -> None:
+    """Judge a student's mean with its 95 % interval against a recomputed one.
+
+    Parameters
+    ----------
+    name : str
+        The student's variable ("improvement[4.5]").
+    interval : object
+        The student's interval: anything with ``mean``, ``low`` and ``high`` (and, if it
+        has one, ``runs``, which must equal ``expected.runs``).
+    expected : metrics.Interval
+        The right interval, recomputed from the task's inputs.
+    rtol : float
+        Tolerance relative to the interval's scale: the larger of ``|mean|`` and the
+        half-width.
+    mistakes : mapping of str to Interval, optional
+        Likely mistakes (cause → the interval it gives), tried in order; see :func:`judge`.
+    unit, what, nan_hint
+        See :func:`judge`.
+
+    Raises
+    ------
+    CheckFailed
+        Naming ``name``: not an interval, a part that is not a finite number, another
+        number of runs, a matching mistake's cause, a right mean with wrong ends, or no
+        match at all.
+    """
+    parts = _interval_parts(interval, name)
+    got = np.array([float(argument_array(part, f"{name}.{label}", "one number",
+                                         shape=(), allow_nan=True))
+                    for part, label in zip(parts, ("mean", "low", "high"), strict=True)])
+    if np.any(np.isnan(got)):
+        raise CheckFailed(f"{name} holds NaN (not a number){f': {nan_hint}' if nan_hint else ''}")
+    runs = getattr(interval, "runs", expected.runs)
+    if runs != expected.runs:
+        raise CheckFailed(
+            f"{name} is over {runs} runs, but the task has {expected.runs}: use the per-run "
+            f"values of all {expected.runs} runs")
+    right = np.array([expected.mean, expected.low, expected.high])
+    scale = max(abs(expected.mean), expected.half_width, 1e-300)
+
+    def near(a: np.ndarray, b: np.ndarray) -> bool:
+        return bool(np.all(np.abs(a - b) <= rtol * scale))
+
+    if near(got, right):
+        return
+    for cause, candidate in (mistakes or {}).items():
+        if candidate is None:
+            continue
+        wrong = np.array([candidate.mean, candidate.low, candidate.high], dtype=float)
+        if np.all(np.isfinite(wrong)) and not near(wrong, right) and near(got, wrong):
+            raise CheckFailed(f"{name} is not right: {cause}")
+    unit_text = f" {unit}" if unit else ""
+    if near(got[:1], right[:1]):
+        raise CheckFailed(
+            f"{name}: the mean ({got[0]:.6g}{unit_text}) is right, but the interval's ends "
+            f"are not those of metrics.mean_ci95 of the per-run values")
+    raise CheckFailed(
+        f"{name} (mean {got[0]:.6g}{unit_text}) does not match {what} (to "
+        f"{tolerance_text(rtol)} relative), and not by one of the usual mistakes")
+
+
+def _around(mean: float, half: float, runs: int) -> metrics.Interval:
+    return metrics.Interval(mean, mean - half, mean + half, runs)
+
+
+def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
+                      second_name: str) -> dict[str, metrics.Interval]:
+    """The usual mistakes of a paired difference ``first − second`` with its 95 % interval.
+
+    Parameters
+    ----------
+    first, second : ndarray, shape (runs,)
+        Per-run values of the two conditions, run r of both on the same noise.
+    first_name, second_name : str
+        What they are, for the messages ("the raw readings' MSE").
+
+    Returns
+    -------
+    dict of str to metrics.Interval
+        Cause → the interval it gives: the sign reversed, the runs treated as unpaired,
+        the two separate intervals combined, the standard deviation for the standard
+        error, 1.96 for Student's t, the population standard deviation, each condition
+        alone.
+    """
+    runs = first.size
+    difference = first - second
+    right = metrics.mean_ci95(difference)
+    t = metrics.t_critical_95(runs - 1)
+    s = float(np.std(difference, ddof=1))
+    alone_first, alone_second = metrics.mean_ci95(first), metrics.mean_ci95(second)
+    unpaired = t * np.sqrt((np.var(first, ddof=1) + np.var(second, ddof=1)) / runs)
+    both = f"{first_name} − {second_name}"
+    return {
+        f"the sign is reversed: it is {second_name} − {first_name}; the task asks for "
+        f"{both}": metrics.mean_ci95(second - first),
+        "it combines the two separate intervals. The runs are paired (the same noise in run "
+        "r), so take the interval of the per-run differences: it is much narrower because "
+        "the shared noise cancels":
+            _around(right.mean, alone_first.half_width + alone_second.half_width, runs),
+        "it treats the two as independent samples (unpaired). The runs are paired (the same "
+        "noise in run r): take the interval of the per-run differences":
+            _around(right.mean, unpaired, runs),
+        "its half-width uses the standard deviation of the differences; a 95 % interval of "
+        "the mean uses its standard error, the standard deviation divided by √runs":
+            _around(right.mean, t * s, runs),
+        f"its half-width uses the normal 1.96 instead of Student's t value for {runs - 1} "
+        f"degrees of freedom (metrics.mean_ci95 does this for you)":
+            _around(right.mean, NORMAL_95 * s / np.sqrt(runs), runs),
+        "the standard deviation is the population one (divided by runs); a sample standard "
+        "deviation divides by runs − 1":
+            _around(right.mean, t * float(np.std(difference)) / np.sqrt(runs), runs),
+        f"it is the interval of {first_name} alone, not of the per-run differences "
+        f"{both}": alone_first,
+        f"it is the interval of {second_name} alone, not of the per-run differences "
+        f"{both}": alone_second,
+    }
+
+
+def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
+                 dt: float | None = None) -> dict[str, np.ndarray | None]:
+    """The usual mistakes of a mean squared error after a burn-in.
+
+    Parameters
+    ----------
+    estimate : ndarray, shape (..., n)
+        Positions (cm) whose MSE against ``truth`` is due; NaN allowed before the burn-in.
+    truth : ndarray, shape (n,)
+        True positions (cm).
+    burn_in_steps : int
+        Samples to leave out at the start.
+    dt : float, optional
+        Time step (s): adds the burn-in counted in seconds instead of samples.
+
+    Returns
+    -------
+    dict of str to ndarray or None
+        Cause → the MSE (shape (...)) that mistake gives: the root of the MSE, the sum
+        instead of the mean, errors not squared, absolute errors, the variance of the
+        error, the whole trial, the burn-in in seconds. None where the mistake gives
+        no finite number (NaN samples it would include).
+    """
+    with np.errstate(all="ignore"):
+        error = estimate - truth
+        kept = error[..., burn_in_steps:]
+        right = np.mean(kept**2, axis=-1)
+        mistakes: dict[str, np.ndarray | None] = {
+            "it is the root mean squared error (RMSE, in cm): the MSE is its square, in cm², "
+            "without the root": np.sqrt(right),
+            "it is the sum of the squared errors: the MSE is their mean over the samples":
+                np.sum(kept**2, axis=-1),
+            "the errors are not squared (the mean error): square each error, then average":
+                np.mean(kept, axis=-1),
+            "it is the mean absolute error: square each error, then average":
+                np.mean(np.abs(kept), axis=-1),
+            "it is the variance of the error (its mean is subtracted): the MSE averages the "
+            "squared errors themselves, bias included": np.var(kept, axis=-1),
+        }
+        if burn_in_steps:
+            mistakes[f"it is the MSE of the whole trial: the first {burn_in_steps} samples "
+                     f"(the burn-in) must be left out"] = np.mean(error**2, axis=-1)
+        if dt is not None and burn_in_steps:
+            seconds = burn_in_steps * dt
+            if float(seconds).is_integer() and int(seconds) != burn_in_steps:
+                mistakes[f"it leaves out the first {seconds:g} sample(s): the burn-in is "
+                         f"{seconds:g} s, which is {burn_in_steps} samples of {dt:g} s; "
+                         f"count it in samples"] = np.mean(error[..., int(seconds):] ** 2,
+                                                           axis=-1)
+    return {cause: (value if np.all(np.isfinite(value)) else None)
+            for cause, value in mistakes.items()}

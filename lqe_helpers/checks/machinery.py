@@ -1,0 +1,224 @@
+"""What every check shares: CheckFailed, tolerances, calling the student's code, arguments.
+
+Every check runs a student's function through :func:`call_student` (the time limit and the
+one-line reports of :mod:`lqe_helpers.student_code`), reads what it returned with
+:func:`student_result`, and validates each value a student passes with
+:func:`argument_array` or :func:`positive_number`, so that a wrong type or shape is one
+:class:`CheckFailed` naming the argument. ``__tracebackhide__`` keeps these frames out of
+pytest's report; :class:`CheckFailed` keeps them out of Jupyter's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from .. import student_code
+from ..student_code import OwnCodeTraceback, StudentCodeError, calling
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+#: Seed of the random models the function checks use (fixed: a check gives the same
+#: verdict and message every time it runs).
+SEED = 2026
+
+#: Relative tolerance of the function checks (:func:`check_filter`,
+#: :func:`check_compensation`), scaled by the largest entry of the correct result.
+FUNCTION_RTOL = 1e-9
+
+#: Relative tolerance of a mean squared error, of the expected value's size.
+MSE_RTOL = 1e-6
+
+#: Relative tolerance of :func:`check_initial_covariance` and :func:`check_fusion`.
+MATRIX_RTOL = 1e-9
+
+#: Tolerance (s) of :func:`check_convergence_time`: the time is a whole number of samples.
+TIME_ATOL = 1e-9
+
+#: Relative tolerance (of the interval's scale: its mean or half-width, whichever is
+#: larger) of a paired difference with its 95 % interval.
+INTERVAL_RTOL = 1e-9
+
+#: Tolerance used when matching a wrong answer of a function against a typical mistake.
+MISTAKE_RTOL = 1e-6
+
+
+class CheckFailed(OwnCodeTraceback, AssertionError):
+    """A task's answer is not right yet; the message says what is wrong.
+
+    An ``AssertionError``, so "Run All" stops at the wrong step. In Jupyter it shows the
+    student's own cells and the message only (:class:`~lqe_helpers.student_code.OwnCodeTraceback`).
+    """
+
+
+class NotWrittenYet(CheckFailed):
+    """The student's function still raises NotImplementedError."""
+
+
+class TimedOut(CheckFailed):
+    """The student's function did not return within the time limit."""
+
+
+#: Failures after which a check calls the student's function no more (it would not help).
+STOP_CALLING = (NotWrittenYet, TimedOut)
+
+
+def passed(text: str) -> None:
+    """Print a check's one ✓ line."""
+    print(f"✓ {text}")
+
+
+def tolerance_text(value: float) -> str:
+    """A tolerance for a message: 1e-09 as "1e-9", 0.5 as "0.5"."""
+    mantissa, exponent = f"{value:.0e}".split("e")
+    return f"{mantissa}e{int(exponent)}" if value < 1e-3 else f"{value:g}"
+
+
+def time_limit_text() -> str:
+    """What a ✓ line says of the time limit: "each call given at most 5 s"."""
+    return f"each call given at most {calling.TIME_LIMIT:g} s"
+
+
+# ------------------------------------------------------------------------------------------
+# The student's functions
+# ------------------------------------------------------------------------------------------
+
+def require_callable(function: object, what: str, check: str) -> str:
+    """The name of the student's function, or CheckFailed if ``function`` is not one."""
+    if not callable(function):
+        found = "None" if function is None else f"a {type(function).__name__}"
+        raise CheckFailed(
+            f"{check} needs your function {what} itself (its name, without parentheses or "
+            f"arguments), got {found}")
+    return student_code.function_name(function)
+
+
+def call_student(function: Callable, *args: object, name: str, where: str,
+                 arg_names: Sequence[str] | None = None, hint: str = "",
+                 shape_hint: str = "") -> object:
+    """``student_code.call`` for a check: every failure becomes one CheckFailed.
+
+    NotImplementedError becomes :class:`NotWrittenYet` and a time-out :class:`TimedOut`
+    (:data:`STOP_CALLING`: a check stops at once, calling again would not help);
+    everything else (an exception, an input changed in place, ...) a
+    :class:`CheckFailed` with the same message that shows the student's own lines where
+    it happened.
+    """
+    try:
+        return student_code.call(function, *args, name=name, where=where, arg_names=arg_names,
+                                 hint=hint, shape_hint=shape_hint)
+    except student_code.NotWrittenYet as error:
+        failure: CheckFailed = NotWrittenYet(str(error))
+    except student_code.TimedOut as error:
+        failure = TimedOut(str(error))
+        failure.student_traceback = error.student_traceback
+    except StudentCodeError as error:
+        failure = CheckFailed(str(error))
+        failure.student_traceback = error.student_traceback
+    raise failure
+
+
+def student_result(value: object, *, name: str, what: str,
+                   shape: Sequence[int | None] | None = None, allow_nan: bool = False,
+                   where: str = "") -> np.ndarray:
+    """``student_code.result_array`` for a check: a float64 array, or one CheckFailed.
+
+    Floats of less than double precision are refused: a function check compares to 1e-9.
+    """
+    try:
+        return student_code.result_array(value, name=name, what=what, shape=shape,
+                                         allow_nan=allow_nan, double=True, where=where)
+    except StudentCodeError as error:
+        failure = CheckFailed(str(error))
+    raise failure
+
+
+# ------------------------------------------------------------------------------------------
+# Values the student passes to a check
+# ------------------------------------------------------------------------------------------
+
+def argument_array(value: object, name: str, what: str,
+                   shape: Sequence[int | None] | None = None,
+                   allow_nan: bool = False) -> np.ndarray:
+    """A value the student passed, as a float array, or CheckFailed naming it.
+
+    Parameters
+    ----------
+    value : object
+        What was passed.
+    name : str
+        The argument's name as the student knows it ("C", "mse_filtered[4.5]").
+    what : str
+        What it must be ("a 2 × 3 matrix", "one number (cm²)").
+    shape, allow_nan
+        See :func:`lqe_helpers.student_code.array_problem`.
+    """
+    problem = student_code.array_problem(value, shape=shape, allow_nan=allow_nan,
+                                         returned=False)
+    if problem is not None:
+        raise CheckFailed(f"{name} must be {what}, got {problem}")
+    return np.asarray(value, dtype=float)
+
+
+def positive_number(value: object, name: str, unit: str) -> float:
+    """A number > 0 the student passed (σ, Δt, ...), or CheckFailed naming it."""
+    what = f"a number > 0{f' {unit}' if unit else ''}"
+    number = float(argument_array(value, name, what, shape=()))
+    if number <= 0:
+        raise CheckFailed(f"{name} must be {what}, got {number:g}")
+    return number
+
+
+# ------------------------------------------------------------------------------------------
+# Comparing results
+# ------------------------------------------------------------------------------------------
+
+def close(a: np.ndarray, b: np.ndarray, rtol: float) -> bool:
+    """``a`` and ``b`` agree within ``rtol`` of the larger of 1 and b's largest entry.
+
+    NaN must stand where NaN stands (a row with no value yet, e.g. before a delay).
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    if a.shape != b.shape:
+        return False
+    finite = np.isfinite(b)
+    if not np.array_equal(np.isfinite(a), finite):
+        return False
+    if not finite.any():
+        return True
+    scale = max(1.0, float(np.max(np.abs(b[finite]))))
+    with np.errstate(over="ignore", invalid="ignore"):
+        return bool(np.all(np.abs(a[finite] - b[finite]) <= rtol * scale))
+
+
+def match_mistake(mistakes: Sequence[str], compute: Callable[[str, int], np.ndarray | None],
+                  answers: dict[int, np.ndarray], correct: dict[int, np.ndarray],
+                  rows: Callable[[int, np.ndarray], np.ndarray] | None = None) -> str | None:
+    """The first mistake whose result equals the student's answer on every case it can run.
+
+    ``answers`` maps case index → the student's (right-shaped) result; ``compute(mistake,
+    index)`` gives the mistaken result or None. A mistake counts only if it differs from
+    the correct result on at least one case, so it really explains the wrong answer.
+    ``rows(index, wrong)``, if given, is a boolean mask of the rows to compare; a case
+    where it selects none is skipped.
+    """
+    for mistake in mistakes:
+        explained = False
+        consistent = True
+        for index, answer in answers.items():
+            wrong = compute(mistake, index)
+            if wrong is None:
+                continue
+            part = rows(index, wrong) if rows is not None else slice(None)
+            if rows is not None and not np.any(part):
+                continue
+            if not close(answer[part], wrong[part], MISTAKE_RTOL):
+                consistent = False
+                break
+            if not close(correct[index][part], wrong[part], MISTAKE_RTOL):
+                explained = True
+        if consistent and explained:
+            return mistake
+    return None

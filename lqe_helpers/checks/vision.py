@@ -1,0 +1,347 @@
+"""Checks of notebook 01, question (a): the filter of eq. (5), and vision alone at two noises.
+
+- :func:`check_filter` (Task 1): the student's ``my_filter`` on small random models,
+  against the pack's engine (:func:`lqe_helpers.filter.kalman_filter`);
+- :func:`check_vision_mse` (Task 2): the raw and filtered MSEs at σ_v = 1.5 and 4.5 cm,
+  recomputed from the scenario's draw with the engine;
+- :func:`check_vision_difference` (Task 3): the paired raw − filtered difference over
+  the Monte Carlo runs, recomputed with :func:`lqe_helpers.experiments.track`.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+
+import numpy as np
+
+from .. import experiments, metrics, model, simulation
+from ..filter import kalman_filter
+from ..scenario import DEFAULT
+from . import filter_models
+from .filter_models import FILTER_MISTAKES, FILTER_STEPS, FilterModel
+from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .machinery import (
+    FUNCTION_RTOL,
+    INTERVAL_RTOL,
+    MSE_RTOL,
+    STOP_CALLING,
+    CheckFailed,
+    call_student,
+    close,
+    match_mistake,
+    passed,
+    require_callable,
+    student_result,
+    time_limit_text,
+    tolerance_text,
+)
+
+__tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+#: The question's two noise levels of vision (cm).
+SIGMAS_V = (1.5, 4.5)
+
+_FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+_FILTER_SHAPE_HINT = (
+    "The shapes in one product or sum do not fit: write the shape beside each term (y_j is "
+    "(m,), ẑ is (k,), C is (m, k), P and A are (k, k), R is (m, m), K is (k, m)).")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 1: the filter
+# ------------------------------------------------------------------------------------------
+
+def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
+    """Check a student's filter ``my_filter(y, A, C, Q, R, z0, P0)`` against Tutorial eq. (5).
+
+    The function is called on six small random models (1–4 states, 1–3 sensors, 15
+    steps, from the fixed seed :data:`SEED`), each call given at most
+    :data:`lqe_helpers.student_code.TIME_LIMIT` s, and must return the estimates, an
+    array of shape (n, k) whose row j is ẑ after y_j, equal to the pack's engine
+    (:func:`lqe_helpers.filter.kalman_filter`, computed before the student's function
+    runs) within :data:`FUNCTION_RTOL` of the largest estimate.
+
+    Parameters
+    ----------
+    my_filter : callable
+        The student's function.
+
+    Raises
+    ------
+    CheckFailed
+        If the function is not written yet, raises an error, does not return in time,
+        returns something of the wrong type or shape, changes its inputs, or computes
+        other numbers; the message names the mistake when it is a typical one.
+    """
+    name = require_callable(my_filter, "my_filter", "check_filter")
+    models = filter_models.models()
+    correct = {index: filter_models.right_estimates(index) for index in range(len(models))}
+    answers: dict[int, np.ndarray] = {}
+    errors: dict[int, CheckFailed] = {}
+    for index, m in enumerate(models):
+        try:
+            output = call_student(my_filter, *m.args, name=name, where=m.describe(),
+                                  arg_names=_FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT)
+        except STOP_CALLING:
+            raise
+        except CheckFailed as failure:
+            errors[index] = failure
+            continue
+        answers[index] = _filter_output(output, name, m)
+
+    wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
+    if not wrong and not errors:
+        passed(f"{name} matches eq. (5) on {len(models)} random models (1–4 states, 1–3 "
+               f"sensors, {FILTER_STEPS} steps) to {tolerance_text(FUNCTION_RTOL)}, "
+               f"{time_limit_text()}")
+        return
+    mistake = match_mistake(list(FILTER_MISTAKES), filter_models.mistaken_estimates, answers,
+                            correct)
+    if mistake is not None:
+        also = " (On some models it also raises an error.)" if errors else ""
+        raise CheckFailed(f"{name} does not follow eq. (5): {FILTER_MISTAKES[mistake]}.{also}")
+    if errors:
+        raise errors[min(errors)]
+    _explain_wrong_rows(name, models[wrong[0]], answers[wrong[0]], correct[wrong[0]])
+
+
+def _explain_wrong_rows(name: str, m: FilterModel, answer: np.ndarray,
+                        right: np.ndarray) -> None:
+    """CheckFailed for a filter whose numbers differ in no typical way."""
+    if answer.shape[0] > 1 and np.allclose(answer, answer[-1], rtol=0, atol=0) and \
+            close(answer[-1], right[-1], FUNCTION_RTOL):
+        raise CheckFailed(
+            f"every row of {name}'s result is the last estimate (on {m.describe()}): the "
+            f"same array was stored at every step and then changed in place. Store a "
+            f"separate copy of ẑ at each step")
+    scale = max(1.0, float(np.max(np.abs(right))))
+    bad_rows = np.any(np.abs(answer - right) > FUNCTION_RTOL * scale, axis=1)
+    row = int(np.argmax(bad_rows))
+    if row == 0:
+        where = ("Already the first estimate (after y_0, starting from ẑ = z0 and P = P0) "
+                 "differs: check the gain K and the ẑ line of eq. (5)")
+    else:
+        first = "The first estimate is" if row == 1 else f"The first {row} estimates are"
+        where = (f"{first} right, then row {row} differs: K and ẑ are right at the "
+                 f"start, so check how P is carried to the next step (third line of "
+                 f"eq. (5))")
+    raise CheckFailed(
+        f"{name} does not match eq. (5) on {m.describe()}. {where}. (Largest difference "
+        f"{float(np.max(np.abs(answer - right))):.3g} where the estimates are of size "
+        f"{scale:.3g}.)")
+
+
+def _filter_output(output: object, name: str, m: FilterModel) -> np.ndarray:
+    """The filter's output as an (n, k) array, or a CheckFailed naming what came back."""
+    n, k = m.n, m.k
+    what = f"the estimates ẑ, an array of shape (n, k) = {(n, k)}"
+    where = f"on {m.describe()}"
+    array = student_result(output, name=name, what=what, where=m.describe())
+    shape = array.shape
+    if shape == (n, k):
+        return array
+    if shape == (n + 1, k):
+        first = "its first row is z0" if np.allclose(array[0], m.z0) else "one row too many"
+        message = (f"returned {n + 1} rows for {n} measurements ({first}) {where}. Row j "
+                   f"must be the estimate after y_j, so there are exactly n = {n} rows: z0 "
+                   f"is the starting point, not an estimate")
+    elif shape == (n, k, k):
+        message = (f"returned an array of shape {shape}, the shape of the covariances P, "
+                   f"{where}; it must return the estimates ẑ, shape (n, k) = {(n, k)}")
+    elif shape == (n, k, 1):
+        message = (f"returned shape {shape} {where}: each estimate is a column (k, 1). "
+                   f"Each row of the result must be a flat vector of k = {k} numbers, so "
+                   f"the result has shape (n, k) = {(n, k)}")
+    elif shape == (n, k, m.m):
+        message = (f"returned an array of shape {shape}, the shape of the gains K, "
+                   f"{where}; it must return the estimates ẑ, shape (n, k) = {(n, k)}")
+    elif shape == (k, n):
+        message = (f"returned shape {shape} {where}: the result is transposed. Rows are "
+                   f"time steps, columns are states: shape (n, k) = {(n, k)}")
+    elif shape == (k, k):
+        message = (f"returned one {k} × {k} matrix {where} (the last covariance P?); it "
+                   f"must return all n = {n} estimates ẑ, shape (n, k) = {(n, k)}")
+    elif shape == (k,):
+        message = (f"returned a single estimate of shape {shape} {where} (the last one?); "
+                   f"it must return one estimate per measurement, shape (n, k) = {(n, k)}")
+    elif shape == (n, m.m) and m.m != k:
+        message = (f"returned shape {shape} {where}: one column per sensor. It must return "
+                   f"the state estimates ẑ, one column per state: shape (n, k) = {(n, k)}")
+    else:
+        message = (f"returned an array of shape {shape} {where}; expected the estimates, "
+                   f"shape (n, k) = {(n, k)} (n = {n} measurements, k = {k} states)")
+    raise CheckFailed(f"{name} {message}")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 2: one trial at both noise levels
+# ------------------------------------------------------------------------------------------
+
+def _readings(sigma_v: float, scale: float | None = None) -> np.ndarray:
+    """Vision's readings (n, 1) (cm): truth + scale · the scenario's draw (scale = σ_v)."""
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    return simulation.measure(DEFAULT.truth[:, 0], noise, [sigma_v if scale is None else scale])
+
+
+def _filtered(readings: np.ndarray, r_variance: float) -> np.ndarray:
+    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]]."""
+    return kalman_filter(readings, DEFAULT.A, model.observation_matrix(("vision",)), DEFAULT.Q,
+                         np.array([[r_variance]]), np.asarray(DEFAULT.z0, dtype=float),
+                         DEFAULT.P0).estimates[:, 0]
+
+
+@functools.cache
+def _trial_mses(sigma_v: float) -> dict[str, object]:
+    """The right MSEs of Task 2 at ``sigma_v`` and the likely mistakes (cm²)."""
+    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
+    y = _readings(sigma_v)
+    positions = _filtered(y, sigma_v**2)
+
+    def mse(x: np.ndarray) -> float:
+        return float(metrics.mse(x, truth, burn))
+
+    other = SIGMAS_V[1] if sigma_v == SIGMAS_V[0] else SIGMAS_V[0]
+    raw, filtered = mse(y[:, 0]), mse(positions)
+    filtered_mistakes = {
+        "R holds σ_v (cm) where its variance σ_v² (cm²) belongs, so the filter weighs "
+        "vision wrongly": mse(_filtered(y, sigma_v)),
+        "R holds σ_v⁴: the variance σ_v² was squared again": mse(_filtered(y, sigma_v**4)),
+        f"R is that of σ_v = {other:g} cm: make R from the σ_v of these readings":
+            mse(_filtered(y, other**2)),
+        "it is the MSE of the raw readings, not of the filtered estimate": raw,
+        "the readings were made with σ_v² instead of σ_v (truth + σ_v² · noise)":
+            mse(_filtered(_readings(sigma_v, sigma_v**2), sigma_v**2)),
+        "the readings were made without σ_v (truth + noise): scale the unit noise by σ_v":
+            mse(_filtered(_readings(sigma_v, 1.0), sigma_v**2)),
+        **mse_mistakes(positions, truth, burn, dt),
+    }
+    raw_mistakes = {
+        "it is the MSE of the filtered estimate, not of the raw readings": filtered,
+        "the readings were made with σ_v² instead of σ_v (truth + σ_v² · noise)":
+            mse(_readings(sigma_v, sigma_v**2)[:, 0]),
+        "the readings were made without σ_v (truth + noise): scale the unit noise by σ_v":
+            mse(_readings(sigma_v, 1.0)[:, 0]),
+        **mse_mistakes(y[:, 0], truth, burn, dt),
+    }
+    return {"raw": raw, "filtered": filtered, "raw_mistakes": raw_mistakes,
+            "filtered_mistakes": filtered_mistakes, "other": other}
+
+
+def _by_sigma(values: object, name: str, what: str) -> dict[float, object]:
+    """The student's dict keyed by σ_v (cm), with both of the question's levels in it."""
+    if not isinstance(values, dict):
+        found = "None" if values is None else f"a {type(values).__name__}"
+        raise CheckFailed(f"{name} must be a dict of {what} keyed by σ_v (cm), e.g. "
+                          f"{name}[4.5], got {found}")
+    keys = {}
+    for key in values:
+        if isinstance(key, (int, float, np.number)) and not isinstance(key, bool):
+            keys[float(key)] = values[key]
+    missing = [sigma for sigma in SIGMAS_V if sigma not in keys]
+    if missing:
+        have = ", ".join(repr(key) for key in values) or "none"
+        raise CheckFailed(f"{name} has no entry for σ_v = {missing[0]:g} cm (its keys: "
+                          f"{have}); the task asks for both noise levels, keyed by the number "
+                          f"σ_v itself")
+    return keys
+
+
+def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float, float]) -> None:
+    """Check Task 2's MSEs of the raw readings and of the filtered estimate at both σ_v.
+
+    Recomputed from the task's own inputs before looking at the student's: the readings
+    ``truth + σ_v · noise`` of the scenario's draw at σ_v = 1.5 and 4.5 cm, filtered by
+    the pack's engine with ``R = [[σ_v²]]``, ``C = [[1, 0, 0]]``, ``DEFAULT.A``,
+    ``DEFAULT.Q``, z0 and ``DEFAULT.P0``; each MSE (cm²) after the first
+    ``DEFAULT.burn_in_steps`` samples must agree within :data:`MSE_RTOL` relative.
+
+    Parameters
+    ----------
+    mse_readings, mse_filtered : dict of float to float
+        The student's MSEs (cm²) keyed by σ_v (cm).
+
+    Raises
+    ------
+    CheckFailed
+        Naming the entry and the likely cause: σ_v in R where σ_v² belongs, R of the
+        other noise level, the readings' MSE for the estimate's, readings made without
+        σ_v, the whole trial, the burn-in in seconds, the RMSE, ...
+    """
+    readings = _by_sigma(mse_readings, "mse_readings", "MSEs (cm²) of the readings")
+    filtered = _by_sigma(mse_filtered, "mse_filtered", "MSEs (cm²) of the estimates")
+    for sigma in SIGMAS_V:
+        right = _trial_mses(sigma)
+        other = _trial_mses(right["other"])
+        for label, values, kind in (("mse_readings", readings, "raw"),
+                                    ("mse_filtered", filtered, "filtered")):
+            judge(f"{label}[{sigma:g}]", values[sigma], right[kind], MSE_RTOL, unit="cm²",
+                  what=f"the {'readings' if kind == 'raw' else 'filtered estimate'}' MSE "
+                       f"recomputed from the task's inputs",
+                  mistakes={**right[f"{kind}_mistakes"],
+                            f"it is the value for σ_v = {right['other']:g} cm": other[kind]})
+    passed(f"the MSEs of the readings and of the filtered estimate at σ_v = "
+           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match the pack's engine on the "
+           f"scenario's draw (after the first {DEFAULT.burn_in_steps} samples) to "
+           f"{tolerance_text(MSE_RTOL)} relative")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 3: many runs, paired
+# ------------------------------------------------------------------------------------------
+
+@functools.cache
+def _monte_carlo() -> dict[str, np.ndarray]:
+    """Per-run MSEs (runs, 2) of the readings and estimates at both σ_v (cm²), read-only."""
+    batch = experiments.track(DEFAULT, sigmas=[[s] for s in SIGMAS_V], runs=DEFAULT.mc_runs)
+    truth = DEFAULT.truth[:, 0]
+    values = {"raw": batch.measurement_mse("vision"), "filtered": batch.mse(),
+              "raw_whole": metrics.mse(batch.measurements[..., 0], truth),
+              "filtered_whole": metrics.mse(batch.positions, truth)}
+    for array in values.values():
+        array.setflags(write=False)
+    return values
+
+
+def check_vision_difference(improvement: dict[float, metrics.Interval]) -> None:
+    """Check Task 3's paired differences raw − filtered MSE over the Monte Carlo runs.
+
+    Recomputed from the task's inputs before looking at the student's: ``DEFAULT.mc_runs``
+    runs at σ_v = 1.5 and 4.5 cm (:func:`lqe_helpers.experiments.track`), per-run MSEs
+    after the burn-in, and ``metrics.mean_ci95`` of the per-run differences; mean and
+    ends must agree within :data:`INTERVAL_RTOL` of the interval's scale.
+
+    Parameters
+    ----------
+    improvement : dict of float to metrics.Interval
+        The student's intervals keyed by σ_v (cm).
+
+    Raises
+    ------
+    CheckFailed
+        Naming the entry and the likely cause: the sign reversed, an unpaired interval,
+        the whole trial, the other noise level, a ratio instead of a difference, one
+        MSE alone, the standard deviation for the standard error, ...
+    """
+    intervals = _by_sigma(improvement, "improvement", "paired intervals (metrics.Interval)")
+    runs = _monte_carlo()
+    for column, sigma in enumerate(SIGMAS_V):
+        raw, filtered = runs["raw"][:, column], runs["filtered"][:, column]
+        other = runs["raw"][:, 1 - column] - runs["filtered"][:, 1 - column]
+        mistakes = {
+            **interval_mistakes(raw, filtered, "the raw readings' MSE", "the filtered MSE"),
+            "the MSEs are those of the whole trial: leave out the burn-in in both":
+                metrics.mean_ci95(runs["raw_whole"][:, column]
+                                  - runs["filtered_whole"][:, column]),
+            f"it is the value for σ_v = {SIGMAS_V[1 - column]:g} cm": metrics.mean_ci95(other),
+            "it is the interval of the ratio raw / filtered; the task asks for the paired "
+            "difference raw − filtered": metrics.mean_ci95(raw / filtered),
+        }
+        judge_interval(f"improvement[{sigma:g}]", intervals[sigma],
+                       metrics.mean_ci95(raw - filtered), INTERVAL_RTOL, unit="cm²",
+                       what="the paired difference raw − filtered MSE recomputed from the "
+                            "task's inputs", mistakes=mistakes)
+    passed(f"raw − filtered MSE, paired over {DEFAULT.mc_runs} runs at σ_v = "
+           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm: mean and 95 % interval match the "
+           f"pack's engine on the scenario's draws to {tolerance_text(INTERVAL_RTOL)} "
+           f"relative")

@@ -1,0 +1,47 @@
+"""The student's own functions: calling them safely, and keeping them between notebooks.
+
+Every piece of the pack that runs code a student wrote (the checks after each task, the
+explorers' sliders) calls it through :func:`call` and reads what it returned through
+:func:`result_array`, so a student's function is run, timed and reported in one way
+everywhere; :func:`save` and :func:`load` carry a function from one notebook to the next.
+
+- ``errors``: :class:`StudentCodeError` (what every caller reports, one line) and
+  :class:`OwnCodeTraceback` (in Jupyter, only the student's own frames are shown);
+- ``calling``: :func:`call`, with copies of the inputs and a time limit;
+- ``results``: :func:`result_array` and :func:`array_problem`, a real number array or
+  one line saying what came instead;
+- ``keeping``: :func:`save` and :func:`load`.
+"""
+
+from .calling import NOT_WRITTEN_ADVICE, TIME_LIMIT, call, function_name
+from .errors import (
+    NotWrittenYet,
+    OwnCodeTraceback,
+    StudentCodeError,
+    TimedOut,
+    is_own_code,
+    own_frames,
+)
+from .keeping import SAVE_FOLDER, SAVE_HEADER, SAVED_BY, load, save
+from .results import MAX_MAGNITUDE, array_problem, result_array
+
+__all__ = [
+    "MAX_MAGNITUDE",
+    "NOT_WRITTEN_ADVICE",
+    "SAVED_BY",
+    "SAVE_FOLDER",
+    "SAVE_HEADER",
+    "TIME_LIMIT",
+    "NotWrittenYet",
+    "OwnCodeTraceback",
+    "StudentCodeError",
+    "TimedOut",
+    "array_problem",
+    "call",
+    "function_name",
+    "is_own_code",
+    "load",
+    "own_frames",
+    "result_array",
+    "save",
+]

@@ -1,0 +1,157 @@
+"""Errors shown to students: one line of text, and only their own code in the traceback."""
+
+from __future__ import annotations
+
+import functools
+import linecache
+import os
+import site
+import sys
+import sysconfig
+import traceback
+import types
+from pathlib import Path
+
+__tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
+
+#: Longest piece of a student's error message quoted in ours (characters).
+QUOTE_LENGTH = 200
+
+#: The pack's folder: its code is never the student's.
+_PACKAGE_DIR = Path(__file__).resolve().parent.parent
+
+
+class OwnCodeTraceback:
+    """Mixin for errors shown to students: Jupyter shows only their own code and the message.
+
+    IPython asks an exception for ``_render_traceback_`` before formatting it. This one
+    keeps the frames of the student's own code (cells, saved files; not the pack, numpy,
+    IPython or the standard library) of the error itself and, after them, those of
+    :attr:`student_traceback` (the error their function raised, if this reports one), and
+    formats them as IPython would.
+    """
+
+    #: The traceback of the error the student's own code raised, if this error reports one.
+    student_traceback: types.TracebackType | None = None
+
+    def _render_traceback_(self) -> list[str]:
+        assert isinstance(self, BaseException)
+        self.__cause__ = None
+        self.__suppress_context__ = True
+        tb = own_frames(self.__traceback__, self.student_traceback)
+        shell = _ipython_shell()
+        if shell is None:
+            return traceback.format_exception(type(self), self, tb)
+        return shell.InteractiveTB.structured_traceback(type(self), self, tb, tb_offset=0)
+
+
+class StudentCodeError(OwnCodeTraceback, Exception):
+    """A student's function failed, hung or returned something unusable.
+
+    Its message is one line, written for the student (what went wrong and where), with
+    no library code in it. Checks turn it into a failed check; explorers show it in
+    their numbers line instead of a picture.
+    """
+
+
+class NotWrittenYet(StudentCodeError):
+    """The student's function still raises ``NotImplementedError`` (the stub)."""
+
+
+class TimedOut(StudentCodeError):
+    """The student's function did not return within its time limit (and was stopped)."""
+
+
+def _ipython_shell():
+    module = sys.modules.get("IPython")
+    return module.get_ipython() if module is not None else None
+
+
+@functools.cache
+def _library_folders() -> tuple[str, ...]:
+    paths = sysconfig.get_paths()
+    folders = {paths[key] for key in ("stdlib", "platstdlib", "purelib", "platlib")
+               if key in paths}
+    folders.add(site.getusersitepackages())
+    folders.add(str(_PACKAGE_DIR))
+    return tuple(os.path.join(os.path.realpath(folder), "") for folder in folders)
+
+
+@functools.lru_cache(maxsize=1024)
+def is_own_code(filename: str) -> bool:
+    """Whether ``filename`` (a code object's) holds the student's own code.
+
+    Everything but the pack (``lqe_helpers``), the standard library and installed
+    packages (numpy, IPython, ...) counts as the student's: notebook cells, saved
+    functions, a script of their own.
+    """
+    if filename.startswith("<"):
+        return not filename.startswith("<frozen")
+    path = os.path.realpath(filename)
+    return not path.startswith(_library_folders())
+
+
+def own_frames(*tracebacks: types.TracebackType | None) -> types.TracebackType | None:
+    """One traceback chain of the student's own frames of ``tracebacks``, in order."""
+    kept = []
+    for tb in tracebacks:
+        while tb is not None:
+            if is_own_code(tb.tb_frame.f_code.co_filename):
+                kept.append(tb)
+            tb = tb.tb_next
+    chain = None
+    for tb in reversed(kept):
+        chain = types.TracebackType(chain, tb.tb_frame, tb.tb_lasti, tb.tb_lineno)
+    return chain
+
+
+def one_line(text: str, limit: int = QUOTE_LENGTH) -> str:
+    text = " ".join(text.split())
+    return text if len(text) <= limit else f"{text[: limit - 1]}…"
+
+
+def error_text(error: BaseException) -> str:
+    """``str(error)`` on one line, or a note if even that fails."""
+    try:
+        text = str(error)
+    except BaseException:  # a student's __str__ may raise anything
+        return "(its message could not be shown: its __str__ failed)"
+    if not isinstance(text, str):
+        return "(its message could not be shown)"
+    return one_line(text)
+
+
+def _place(filename: str, lineno: int, function: str) -> str:
+    """Where a line of the student's code is: "in my_filter, line 7 of cell In[5]"."""
+    shell = _ipython_shell()
+    cells = getattr(getattr(shell, "compile", None), "_filename_map", {}) or {}
+    if filename in cells:
+        where = f"line {lineno} of cell In[{cells[filename]}]"
+    else:
+        where = f"line {lineno} of {Path(filename).name}"
+    return where if function == "<module>" else f"in {function}, {where}"
+
+
+def location(tb: types.TracebackType | None) -> str:
+    """" (in my_filter, line 7 of cell In[5]: `S = C @ P`)" for the deepest own frame."""
+    deepest = None
+    while tb is not None:
+        if is_own_code(tb.tb_frame.f_code.co_filename):
+            deepest = tb
+        tb = tb.tb_next
+    if deepest is None:
+        return ""
+    code = deepest.tb_frame.f_code
+    line = linecache.getline(code.co_filename, deepest.tb_lineno).strip()
+    quoted = f": `{one_line(line, 80)}`" if line else ""
+    return f" ({_place(code.co_filename, deepest.tb_lineno, code.co_name)}{quoted})"
+
+
+
+def short_repr(value: object, limit: int = 40) -> str:
+    """``repr(value)`` on one line, shortened; the type's name if even that fails."""
+    try:
+        text = repr(value)
+    except BaseException:  # a student's __repr__ may raise anything
+        text = type(value).__name__
+    return one_line(text, limit)

@@ -1,0 +1,214 @@
+"""Keeping a student's function between notebooks: ``my_functions/<name>.py``."""
+
+from __future__ import annotations
+
+import ast
+import builtins
+import inspect
+import linecache
+import os
+import stat
+import symtable
+import tempfile
+import textwrap
+import types
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from .calling import call, function_name
+from .errors import StudentCodeError, error_text, short_repr
+
+__tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
+
+#: Folder beside the notebook (the kernel's working folder) where :func:`save` keeps functions.
+SAVE_FOLDER = "my_functions"
+#: First line of every file :func:`save` writes; a file without it is never replaced.
+SAVE_HEADER = "# Written by lqe_helpers.student_code.save: edit the notebook, not this file."
+#: Which task writes each saved function, for :func:`load`'s message.
+SAVED_BY = {"my_filter": "notebook 01 (the check after Task 1)",
+            "compensate": "notebook 05 (the check after Task 1)"}
+
+
+def _folder(folder: str | os.PathLike | None) -> Path:
+    return Path.cwd() / SAVE_FOLDER if folder is None else Path(folder)
+
+
+def _shown(path: Path) -> str:
+    try:
+        return path.relative_to(Path.cwd()).as_posix()
+    except ValueError:
+        return str(path)
+
+
+def _names_from_outside(source: str, name: str) -> set[str]:
+    """Names the saved file would look up outside itself (globals and builtins)."""
+    top = symtable.symtable(source, f"{name}.py", "exec")
+    used = {symbol.get_name() for symbol in top.get_symbols()
+            if symbol.is_referenced() and not symbol.is_assigned()
+            and not symbol.is_imported()}
+
+    def walk(table: symtable.SymbolTable) -> None:
+        for symbol in table.get_symbols():
+            if symbol.is_global() and (symbol.is_referenced() or symbol.is_assigned()):
+                used.add(symbol.get_name())
+        for child in table.get_children():
+            walk(child)
+
+    for child in top.get_children():
+        walk(child)
+    return used - {name}
+
+
+def save(function: Callable, folder: str | os.PathLike | None = None) -> Callable:
+    """Keep a student's function for later notebooks: ``my_functions/<name>.py``.
+
+    The function's source (as written in its notebook cell) is written, after the
+    header line :data:`SAVE_HEADER` and ``import numpy as np``, through a temporary file
+    and ``os.replace``. A file of that name without the header (written by hand) is never
+    replaced; a file that already holds the same text is left untouched. Prints one line,
+    the same whether or not the file changed (a notebook's output does not depend on it).
+
+    Parameters
+    ----------
+    function : callable
+        A function defined with ``def`` at the top of a notebook cell. It may use its
+        arguments, numpy as ``np`` and Python's built-ins only (the later notebook
+        does not have the others).
+    folder : path, optional
+        Where to write; default :data:`SAVE_FOLDER` in the working folder (in Jupyter,
+        the notebook's folder).
+
+    Returns
+    -------
+    callable
+        The function loaded back from the saved file (:func:`load`).
+
+    Raises
+    ------
+    StudentCodeError
+        One line: not a function written with def, its source cannot be read, it uses
+        names of the notebook (listed), the file is someone else's, or it cannot be
+        written (nothing is then changed).
+    """
+    name = function_name(function)
+    if not isinstance(function, types.FunctionType) or name == "your function":
+        raise StudentCodeError(
+            f"save needs a function written with def, got {short_repr(function)}")
+    if function.__closure__:
+        raise StudentCodeError(
+            f"{name} is defined inside another function; save needs a function defined "
+            f"at the top of a cell")
+    try:
+        source = textwrap.dedent(inspect.getsource(function))
+        tree = ast.parse(source)
+    except (OSError, TypeError, SyntaxError):
+        raise StudentCodeError(
+            f"save could not read the code of {name}: define it with def in a notebook "
+            f"cell and run that cell first") from None
+    if len(tree.body) != 1 or not isinstance(tree.body[0], ast.FunctionDef):
+        raise StudentCodeError(f"save could not read the code of {name} as one def")
+    outside = _names_from_outside(source, name)
+    foreign = sorted(word for word in outside
+                     if word != "np" and (word in function.__globals__
+                                          or not hasattr(builtins, word)))
+    if "np" in outside and function.__globals__.get("np", np) is not np:
+        foreign.insert(0, "np (which is not numpy in your notebook)")
+    if foreign:
+        raise StudentCodeError(
+            f"{name} uses {', '.join(foreign)} from the notebook; a saved function may use "
+            f"only its arguments, numpy as np and Python's built-ins. Pass the others in "
+            f"as arguments (or compute them inside), run its cell, then this one again")
+    imports = "import numpy as np\n\n\n" if "np" in outside else "\n"
+    text = (f"{SAVE_HEADER}\n# Loaded in later notebooks by student_code.load({name!r}).\n"
+            f"{imports}{source.rstrip()}\n")
+    path = _folder(folder) / f"{name}.py"
+    shown = _shown(path)
+    if path.is_symlink() or (path.exists() and not path.is_file()):
+        raise StudentCodeError(f"{shown} is not a plain file, so save leaves it as it is: "
+                               f"rename or delete it, then run this cell again")
+    if path.exists():
+        try:
+            old = path.read_text("utf-8")
+        except (OSError, UnicodeDecodeError):
+            old = ""
+        if old.partition("\n")[0] != SAVE_HEADER:
+            raise StudentCodeError(
+                f"{shown} was not written by save (its first line is not save's header), so "
+                f"it is left as it is: rename or delete it, then run this cell again")
+    else:
+        old = None
+    if old != text:
+        _write(path, text)
+    print(f"{name} is saved in {shown}; later notebooks load it from there")
+    return load(name, path.parent)
+
+
+def _write(path: Path, text: str) -> None:
+    """``text`` into ``path`` through a temporary file and ``os.replace``."""
+    temporary = None
+    try:
+        path.parent.mkdir(exist_ok=True)
+        with tempfile.NamedTemporaryFile("w", encoding="utf-8", dir=path.parent,
+                                         prefix=f".{path.stem}.", suffix=".tmp",
+                                         delete=False) as handle:
+            temporary = Path(handle.name)
+            handle.write(text)
+        # A temporary file is private (0600); the saved one reads like any file the student
+        # writes (its old mode, or rw-r--r--).
+        os.chmod(temporary, stat.S_IMODE(path.stat().st_mode) if path.exists() else 0o644)
+        os.replace(temporary, path)
+    except OSError as error:
+        if temporary is not None:
+            temporary.unlink(missing_ok=True)
+        raise StudentCodeError(f"save could not write {_shown(path)}: "
+                               f"{error.strerror or error}") from None
+
+
+def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
+    """A function kept by :func:`save`: runs ``my_functions/<name>.py`` and returns ``name``.
+
+    The file runs in a fresh namespace holding numpy as ``np`` (and nothing of the
+    notebook), under the time limit of :func:`call`.
+
+    Parameters
+    ----------
+    name : str
+        The function's name, e.g. ``"my_filter"``.
+    folder : path, optional
+        Where the file is; default :data:`SAVE_FOLDER` in the working folder.
+
+    Returns
+    -------
+    callable
+        The function.
+
+    Raises
+    ------
+    StudentCodeError
+        One line: the file does not exist (naming the notebook whose task writes it),
+        cannot be read or run, or does not define ``name``.
+    """
+    if not isinstance(name, str) or not name.isidentifier():
+        raise ValueError(f"name must be a function's name, e.g. 'my_filter', got {name!r}")
+    path = _folder(folder) / f"{name}.py"
+    shown = _shown(path)
+    if not path.is_file():
+        writer = SAVED_BY.get(name, f"the notebook whose task defines {name}")
+        raise StudentCodeError(f"{shown} does not exist yet: {writer} writes it when its "
+                               f"check passes; run that first")
+    try:
+        source = path.read_text("utf-8")
+        code = compile(source, str(path), "exec")
+    except (OSError, UnicodeDecodeError, SyntaxError, ValueError) as error:
+        raise StudentCodeError(f"{shown} could not be read as Python: "
+                               f"{error_text(error)}") from None
+    linecache.checkcache(str(path))
+    namespace: dict[str, object] = {"__name__": f"{SAVE_FOLDER}.{name}",
+                                    "__file__": str(path), "np": np, "__builtins__": builtins}
+    call(exec, code, namespace, name=shown, rerun="run this cell again")
+    function = namespace.get(name)
+    if not isinstance(function, types.FunctionType):
+        raise StudentCodeError(f"{shown} does not define a function {name}")
+    return function

@@ -1,0 +1,445 @@
+"""Checks of notebook 01: the worked answers pass, realistic wrong answers fail saying why.
+
+The wrong answers are written here as a student would write them (the task's own code with
+one slip), independently of the mistakes :mod:`lqe_helpers.checks` computes to recognise
+them. The worked filter is the test oracle ``reference_loops`` (outside the package).
+"""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+import pytest
+import reference_loops as reference
+from check_outcomes import assert_fails, assert_passes
+
+from lqe_helpers import checks, experiments, metrics, model, scenario, simulation
+from lqe_helpers.checks import CheckFailed
+from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.student_code import calling
+
+
+@pytest.fixture
+def quick(monkeypatch) -> float:
+    """A short time limit for a student's function (s), so an endless loop ends soon."""
+    monkeypatch.setattr(calling, "TIME_LIMIT", 0.3)
+    return 0.3
+
+
+# ------------------------------------------------------------------------------------------
+# check_filter
+# ------------------------------------------------------------------------------------------
+
+
+def student_filter(y, A, C, Q, R, z0, P0, *, mistake: str = ""):
+    """A student's eq. (5), optionally with one mistake."""
+    z = np.array(z0, dtype=float)
+    P = np.array(P0, dtype=float)
+    if mistake == "C transposed":
+        C = C.T
+    if mistake == "sigma for R":
+        R = np.sqrt(R)                    # R "back to σ" (R is diagonal only by luck)
+    rows = []
+    for j in range(len(y)):
+        if mistake == "P before K":
+            P = A @ (P - P @ C.T @ np.linalg.inv(C @ P @ C.T + R) @ C @ P) @ A.T + Q
+        if mistake == "textbook":
+            P = A @ P @ A.T + Q
+        if mistake == "R alone":
+            K = P @ C.T @ np.linalg.inv(R)
+        else:
+            K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        if mistake == "innovation against z":
+            z = A @ z + K @ (y[j] - C @ z)
+        elif mistake == "no prediction":
+            z = z + K @ (y[j] - C @ z)
+        else:
+            z = A @ z + K @ (y[j] - C @ A @ z)
+        if mistake == "no Q":
+            P = A @ (P - K @ C @ P) @ A.T
+        elif mistake == "no A in P":
+            P = P - K @ C @ P + Q
+        elif mistake == "textbook":
+            P = (np.eye(len(z)) - K @ C) @ P
+        elif mistake != "P before K":
+            P = A @ (P - K @ C @ P) @ A.T + Q
+        rows.append(A @ z if mistake == "prediction" else z.copy())
+    if mistake == "z0 first":
+        return np.array([np.asarray(z0, dtype=float), *rows])
+    if mistake == "z0 first, n rows":
+        return np.array([np.asarray(z0, dtype=float), *rows[:-1]])
+    if mistake == "returns P too":
+        return np.array(rows), P
+    if mistake == "list":
+        return rows
+    if mistake == "columns":
+        return np.array(rows).T
+    return np.array(rows)
+
+
+def test_check_filter_passes_the_worked_solution(capsys) -> None:
+    line = assert_passes(capsys, checks.check_filter, reference.lqe_filter)
+    assert line == ("✓ lqe_filter matches eq. (5) on 6 random models (1–4 states, 1–3 "
+                    "sensors, 15 steps) to 1e-9, each call given at most 5 s")
+
+
+def test_check_filter_passes_a_student_filter_with_inv(capsys) -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return student_filter(y, A, C, Q, R, z0, P0)
+
+    assert "my_filter matches eq. (5)" in assert_passes(capsys, checks.check_filter, my_filter)
+
+
+FILTER_MISTAKES = {
+    "C transposed": "C is used transposed",
+    "sigma for R": "R is used as if it held standard deviations",
+    "R alone": "K is computed with R alone",
+    "innovation against z": "compared with C ẑ, the previous estimate",
+    "no prediction": "the prediction step is missing",
+    "no Q": "Q is left out of the covariance update",
+    "P before K": "P is updated before K is computed",
+    "no A in P": "the covariance update leaves out A … Aᵀ",
+    "textbook": "the textbook predict-then-update order",
+    "prediction": "each row is the prediction A ẑ for the next step",
+    "z0 first, n rows": "the rows are one step late",
+    "z0 first": "returned 16 rows for 15 measurements (its first row is z0)",
+    "returns P too": "returned a tuple of 2 items",
+    "list": "returned a Python list",
+    "columns": "the result is transposed",
+}
+
+
+@pytest.mark.parametrize("mistake", FILTER_MISTAKES)
+def test_check_filter_names_each_typical_mistake(mistake: str) -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return student_filter(y, A, C, Q, R, z0, P0, mistake=mistake)
+
+    message = assert_fails(FILTER_MISTAKES[mistake], checks.check_filter, my_filter)
+    # One message per mistake: no other mistake's phrase appears in it.
+    others = [p for m, p in FILTER_MISTAKES.items() if m != mistake and p in message]
+    assert not others, message
+
+
+def test_check_filter_messages_give_no_code() -> None:
+    """Messages describe the mistake in words and symbols, never as Python."""
+    for mistake in FILTER_MISTAKES:
+        def my_filter(y, A, C, Q, R, z0, P0, mistake=mistake):
+            return student_filter(y, A, C, Q, R, z0, P0, mistake=mistake)
+
+        with pytest.raises(CheckFailed) as info:
+            checks.check_filter(my_filter)
+        for code in ("np.", "linalg", "inv(", "@", ".T", "matrix_power", "append"):
+            assert code not in str(info.value), (mistake, str(info.value))
+
+
+def test_check_filter_rejects_a_hard_coded_answer() -> None:
+    s = scenario.DEFAULT
+    y = simulation.measure(s.truth[:, 0], s.unit_noise(sensors=("vision",)), [s.sigma_v])
+    scenario_estimates = reference.lqe_filter(y, s.A, model.observation_matrix(), s.Q,
+                                              model.measurement_noise_covariance([s.sigma_v]),
+                                              np.zeros(3), s.P0)
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return scenario_estimates
+
+    assert_fails("returned an array of shape (1000, 3)", checks.check_filter, my_filter)
+
+    # Hard-coding the right shape does not help either: the numbers are checked.
+    def right_shape(y, A, C, Q, R, z0, P0):
+        return np.resize(scenario_estimates, (len(y), A.shape[0]))
+
+    assert_fails("does not match eq. (5)", checks.check_filter, right_shape)
+
+
+def test_check_filter_says_not_written_yet() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError
+
+    assert_fails("my_filter is not written yet", checks.check_filter, my_filter)
+
+
+def test_check_filter_reports_other_errors_with_the_model() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return y[:, 0] if A.shape[0] == 1 else reference.lqe_filter(y, A, C, Q, R, z0, P0)
+
+    def broken(y, A, C, Q, R, z0, P0):
+        raise KeyError("P")
+
+    message = assert_fails("broken raised KeyError: 'P' (in broken, line ",
+                           checks.check_filter, broken)
+    assert "`raise KeyError(\"P\")`), on a model with k = 3 states and m = 1 sensor" in message
+    assert "(y (15, 1), A (3, 3), C (1, 3)" in message
+    assert_fails("returned an array of shape (15,)", checks.check_filter, my_filter)
+
+
+def test_check_filter_rejects_a_filter_that_changes_its_inputs() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        z = z0
+        rows = []
+        for y_j in y:
+            K = P0 @ C.T @ np.linalg.inv(C @ P0 @ C.T + R)
+            z += K @ (y_j - C @ A @ z) + (A @ z - z)     # updates z0 in place
+            P0[...] = A @ (P0 - K @ C @ P0) @ A.T + Q
+            rows.append(z.copy())
+        return np.array(rows)
+
+    assert_fails("changed its input", checks.check_filter, my_filter)
+
+
+def test_check_filter_recognises_one_array_stored_n_times() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        z, P, rows = np.array(z0, dtype=float), np.array(P0, dtype=float), []
+        for y_j in y:
+            K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+            z[:] = A @ z + K @ (y_j - C @ A @ z)         # changes the stored array too
+            P = A @ (P - K @ C @ P) @ A.T + Q
+            rows.append(z)
+        return np.array(rows)
+
+    assert_fails("the same array was stored at every step", checks.check_filter, my_filter)
+
+
+def test_check_filter_accepts_other_correct_forms(capsys) -> None:
+    """Joseph form of the update and solve instead of inv: equal up to rounding."""
+    def my_filter(y, A, C, Q, R, z0, P0):
+        z, P, rows = z0, P0, []
+        identity = np.eye(len(z0))
+        for y_j in y:
+            K = np.linalg.solve(C @ P @ C.T + R, C @ P).T
+            z = A @ z + K @ (y_j - C @ A @ z)
+            P_plus = (identity - K @ C) @ P @ (identity - K @ C).T + K @ R @ K.T
+            P = A @ P_plus @ A.T + Q
+            rows.append(z)
+        return np.array(rows)
+
+    assert_passes(capsys, checks.check_filter, my_filter)
+
+
+def test_check_filter_needs_a_function() -> None:
+    assert_fails("needs your function my_filter itself", checks.check_filter, np.zeros(3))
+
+
+def test_check_filter_gives_a_generic_hint_for_an_unknown_mistake() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return student_filter(y, A, C, 2.0 * Q, R, z0, P0)     # Q doubled: no usual mistake
+
+    assert_fails("The first estimate is right, then row 1 differs",
+                 checks.check_filter, my_filter)
+
+
+def test_check_filter_stops_an_endless_loop_at_once(quick) -> None:
+    import time
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        rows, j = [], 0
+        while j < len(y):          # j is never increased
+            rows.append(z0)
+        return np.array(rows)
+
+    start = time.monotonic()
+    message = assert_fails(f"my_filter did not return within {quick:g} s (in my_filter, line",
+                           checks.check_filter, my_filter)
+    assert "rows.append(z0)" in message or "while j < len(y)" in message
+    assert time.monotonic() - start < 6 * quick      # the first model only, not all six
+
+
+def test_check_filter_reports_an_error_whose_message_cannot_be_shown() -> None:
+    class Odd(Exception):
+        def __str__(self):
+            raise RuntimeError("no text")
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise Odd()
+
+    assert_fails("my_filter raised Odd: (its message could not be shown",
+                 checks.check_filter, my_filter)
+
+
+@pytest.mark.parametrize(("stop", "phrase"), [
+    (SystemExit, "my_filter called exit() (SystemExit)"),
+    (KeyboardInterrupt, "my_filter was interrupted (KeyboardInterrupt)"),
+])
+def test_check_filter_reports_exit_and_interrupt_as_one_line(stop, phrase) -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise stop
+
+    assert_fails(phrase, checks.check_filter, my_filter)
+
+
+def test_check_filter_refuses_complex_estimates_even_with_zero_imaginary_part() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return reference.lqe_filter(y, A, C, Q, R, z0, P0) + 0j
+
+    assert_fails("my_filter returned complex numbers (dtype complex128)", checks.check_filter,
+                 my_filter)
+
+
+def test_check_filter_refuses_a_filter_that_patches_the_engine() -> None:
+    """A function that swaps the engine for its own answer gets no ✓, now or later."""
+    import lqe_helpers.filter as engine
+
+    checks_module = sys.modules["lqe_helpers.checks.filter_models"]
+    original = engine.kalman_filter
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        wrong = reference.lqe_filter(y, A, C, Q, 2.0 * R, z0, P0)
+
+        def fake(*args, **kwargs):
+            return type("Fake", (), {"estimates": wrong, "gains": None})()
+
+        engine.kalman_filter = fake
+        checks_module.kalman_filter = fake
+        return wrong
+
+    for _ in range(2):
+        assert_fails("my_filter replaced lqe_helpers.checks.filter_models.kalman_filter, "
+                     "lqe_helpers.filter.kalman_filter (now restored)", checks.check_filter,
+                     my_filter)
+        assert engine.kalman_filter is original
+        assert checks_module.kalman_filter is original
+
+
+# ------------------------------------------------------------------------------------------
+# check_vision_mse (Task 2)
+# ------------------------------------------------------------------------------------------
+
+TRUTH = DEFAULT.truth[:, 0]
+NOISE = DEFAULT.unit_noise(sensors=("vision",))
+BURN = DEFAULT.burn_in_steps
+C_VISION = np.array([[1.0, 0.0, 0.0]])
+
+
+def task2(slip: str = "") -> tuple[dict, dict]:
+    """Task 2 as a student writes it (the notebook's worked code), with one ``slip``."""
+    burn = int(DEFAULT.burn_in) if slip == "burn in seconds" else BURN
+    burn = 0 if slip == "whole trial" else burn
+    R = np.array([[DEFAULT.sigma_v**2]])                    # used if R is never updated
+    mse_readings, mse_filtered = {}, {}
+    for sigma_v in (1.5, 4.5):
+        y = TRUTH[:, None] + (1.0 if slip == "no sigma in y" else sigma_v) * NOISE
+        if slip == "R = sigma":
+            R = np.array([[sigma_v]])
+        elif slip != "R not updated":
+            R = np.array([[sigma_v**2]])
+        estimates = reference.lqe_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, R, np.zeros(3),
+                                         DEFAULT.P0)
+        errors_raw = y[burn:, 0] - TRUTH[burn:]
+        errors_filtered = (y[burn:, 0] if slip == "readings twice" else estimates[burn:, 0]) \
+            - TRUTH[burn:]
+        mse_readings[sigma_v] = np.mean(errors_raw**2)
+        mse_filtered[sigma_v] = np.mean(errors_filtered**2)
+        if slip == "rmse":
+            mse_readings[sigma_v] = np.sqrt(mse_readings[sigma_v])
+            mse_filtered[sigma_v] = np.sqrt(mse_filtered[sigma_v])
+    return mse_readings, mse_filtered
+
+
+def test_check_vision_mse_passes_the_worked_answer(capsys) -> None:
+    line = assert_passes(capsys, checks.check_vision_mse, *task2())
+    assert "σ_v = 1.5 and 4.5 cm" in line and "to 1e-6 relative" in line
+
+
+@pytest.mark.parametrize(("slip", "phrase"), [
+    ("R = sigma", "mse_filtered[1.5] = 0.317"),
+    ("R = sigma", "R holds σ_v (cm) where its variance σ_v² (cm²) belongs"),
+    ("whole trial", "mse_readings[1.5] = 2.05374 cm² is not right: it is the MSE of the whole "
+                    "trial"),
+    ("burn in seconds", "it leaves out the first 1 sample(s): the burn-in is 1 s, which is 100 "
+                        "samples"),
+    ("R not updated", "mse_filtered[4.5] = 2.62341 cm² is not right"),
+    ("R not updated", "R is that of σ_v = 1.5 cm"),
+    ("no sigma in y", "the readings were made without σ_v (truth + noise)"),
+    ("rmse", "it is the root mean squared error (RMSE, in cm)"),
+    ("readings twice", "mse_filtered[1.5] = 2.03754 cm² is not right: it is the MSE of the raw "
+                       "readings"),
+])
+def test_check_vision_mse_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_vision_mse, *task2(slip))
+
+
+def test_check_vision_mse_catches_r_as_sigma_that_only_arithmetic_checks_would_pass() -> None:
+    """The bug of issue 15: R = [[σ_v]] agrees with its own positions, not with the science."""
+    readings, filtered = task2("R = sigma")
+    assert abs(filtered[4.5] / task2()[1][4.5] - 1) > 0.1         # about 18 % off
+    assert_fails("R holds σ_v", checks.check_vision_mse, readings, filtered)
+
+
+def test_check_vision_mse_wants_both_noise_levels_as_numbers() -> None:
+    readings, filtered = task2()
+    assert_fails("mse_readings must be a dict of MSEs (cm²) of the readings keyed by σ_v",
+                 checks.check_vision_mse, readings[4.5], filtered)
+    assert_fails("mse_filtered has no entry for σ_v = 1.5 cm (its keys: '1.5', '4.5')",
+                 checks.check_vision_mse, readings, {str(k): v for k, v in filtered.items()})
+    assert_fails("mse_filtered[4.5] must be one number (cm²), got True (a boolean)",
+                 checks.check_vision_mse, readings, {**filtered, 4.5: True})
+    assert_fails("mse_filtered[1.5] must be one number (cm²), got a complex number",
+                 checks.check_vision_mse, readings, {**filtered, 1.5: filtered[1.5] + 0j})
+    assert_fails("mse_readings[1.5] must be one number (cm²), got an array of shape (2,)",
+                 checks.check_vision_mse, {**readings, 1.5: np.ones(2)}, filtered)
+
+
+# ------------------------------------------------------------------------------------------
+# check_vision_difference (Task 3)
+# ------------------------------------------------------------------------------------------
+
+
+def task3(slip: str = "") -> dict:
+    """Task 3 as a student writes it (the notebook's worked code), with one ``slip``."""
+    batch = experiments.track(DEFAULT, sigmas=[[1.5], [4.5]], runs=DEFAULT.mc_runs)
+    mse_raw, mse_est = batch.measurement_mse("vision"), batch.mse()
+    if slip == "whole trial":
+        mse_raw = metrics.mse(batch.measurements[..., 0], TRUTH)
+        mse_est = metrics.mse(batch.positions, TRUTH)
+    improvement = {}
+    for i, sigma_v in enumerate((1.5, 4.5)):
+        column = 1 - i if slip == "columns swapped" else i
+        raw, est = mse_raw[:, column], mse_est[:, column]
+        if slip == "reversed":
+            improvement[sigma_v] = metrics.mean_ci95(est - raw)
+        elif slip == "ratio":
+            improvement[sigma_v] = metrics.mean_ci95(raw / est)
+        elif slip == "separate intervals":
+            a, b = metrics.mean_ci95(raw), metrics.mean_ci95(est)
+            improvement[sigma_v] = metrics.Interval(a.mean - b.mean, a.low - b.high,
+                                                    a.high - b.low, a.runs)
+        elif slip == "difference of means":
+            improvement[sigma_v] = raw.mean() - est.mean()
+        else:
+            improvement[sigma_v] = metrics.mean_ci95(raw - est)
+    return improvement
+
+
+def test_check_vision_difference_passes_the_worked_answer(capsys) -> None:
+    line = assert_passes(capsys, checks.check_vision_difference, task3())
+    assert "paired over 300 runs at σ_v = 1.5 and 4.5 cm" in line
+
+
+@pytest.mark.parametrize(("slip", "phrase"), [
+    ("reversed", "improvement[1.5] is not right: the sign is reversed"),
+    ("whole trial", "the MSEs are those of the whole trial"),
+    ("columns swapped", "improvement[1.5] is not right: it is the value for σ_v = 4.5 cm"),
+    ("ratio", "it is the interval of the ratio raw / filtered"),
+    ("separate intervals", "it combines the two separate intervals"),
+    ("difference of means", "improvement[1.5] is a number; it must be the metrics.Interval"),
+])
+def test_check_vision_difference_names_the_cause(slip: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_vision_difference, task3(slip))
+
+
+def test_check_vision_difference_judges_against_the_engine_not_the_students_arrays() -> None:
+    """A self-consistent interval of the wrong runs (another seed) does not pass."""
+    other = scenario.Scenario(seed=DEFAULT.seed + 1)
+    batch = experiments.track(other, sigmas=[[1.5], [4.5]], runs=DEFAULT.mc_runs)
+    raw, est = batch.measurement_mse("vision"), batch.mse()
+    improvement = {s: metrics.mean_ci95(raw[:, i] - est[:, i]) for i, s in enumerate((1.5, 4.5))}
+    assert_fails("does not match the paired difference raw − filtered MSE recomputed",
+                 checks.check_vision_difference, improvement)
+
+
+def test_check_vision_needs_no_student_function_and_leaves_the_engine_alone() -> None:
+    """Number checks call no student code; the engine's draw is the scenario's own."""
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    y = simulation.measure(TRUTH, noise, [4.5])
+    assert np.array_equal(y, TRUTH[:, None] + 4.5 * NOISE)
+    assert model.observation_matrix(("vision",)).tolist() == C_VISION.tolist()
