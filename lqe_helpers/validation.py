@@ -14,6 +14,67 @@ import numpy as np
 #: Relative tolerance for "symmetric" and "positive semidefinite" checks.
 MATRIX_RTOL = 1e-8
 
+#: Largest memory (bytes) one call of the public API may allocate for its arrays: 2 GiB.
+#: The pack's largest legitimate call (notebook 04's sweep of 25 σ_p values over 300 runs
+#: of 1 000 samples) needs about 0.6 GiB; a call estimated above this limit is refused by
+#: :func:`check_memory` before anything is allocated, with a ``ValueError`` that names the
+#: parameter responsible and the estimate, instead of numpy's ``MemoryError`` (or minutes
+#: of swapping) on the shared 24 GiB machine.
+MEMORY_LIMIT_BYTES = 2 * 1024**3
+
+#: Bytes of one float64 number.
+FLOAT_BYTES = 8
+
+
+def check_memory(names: str, numbers: int, copies: float = 1.0,
+                 what: str = "") -> int:
+    """Refuse a call that would allocate more than :data:`MEMORY_LIMIT_BYTES`.
+
+    Parameters
+    ----------
+    names : str
+        The parameter(s) responsible, as the caller wrote them, with their values, e.g.
+        ``"runs = 10000000"`` or ``"y of shape (300, 1000, 2) and R of shape (25, 2, 2)"``.
+    numbers : int
+        How many float64 numbers the largest set of arrays alive at once holds (a Python
+        int: no overflow, however absurd the size).
+    copies : float
+        Multiplier for temporaries of the same size (e.g. 2 when a list of steps is
+        stacked into a new array).
+    what : str
+        What the memory is for, quoted in the message (e.g. ``"the estimates"``).
+
+    Returns
+    -------
+    int
+        The estimate in bytes, when it is within the limit.
+
+    Raises
+    ------
+    ValueError
+        ``"<names> would need about 7.5 GiB <what>, more than the limit of 2 GiB
+        (validation.MEMORY_LIMIT_BYTES)"``, raised before anything is allocated.
+    """
+    estimate = math.ceil(int(numbers) * FLOAT_BYTES * copies)
+    if estimate > MEMORY_LIMIT_BYTES:
+        purpose = f" {what}" if what else ""
+        raise ValueError(
+            f"{names} would need about {_bytes_text(estimate)}{purpose}, more than the limit "
+            f"of {_bytes_text(MEMORY_LIMIT_BYTES)} (validation.MEMORY_LIMIT_BYTES); use fewer "
+            f"runs, steps or sweep values, or split the call")
+    return estimate
+
+
+def _bytes_text(size: int) -> str:
+    """A byte count in GiB, with a power of ten when it is astronomically large."""
+    gib = size / 1024**3
+    return f"{gib:.3g} GiB" if gib < 1e6 else f"{gib:.2e} GiB"
+
+
+def elements(shape: tuple[int, ...]) -> int:
+    """Number of entries of an array of ``shape``, as an exact Python int."""
+    return math.prod(int(d) for d in shape)
+
 
 def _describe(value: object) -> str:
     """Short text for a received value: the value itself, or the shape of an array."""
@@ -143,6 +204,10 @@ def whole_steps(name: str, value: float, dt: float) -> int:
     value = finite_number(name, value, "s")
     dt = positive("dt", dt, "s")
     ratio = value / dt
+    if not abs(ratio) < _MAX_WHOLE_STEPS:  # also catches inf from 1e308 / 0.01
+        raise ValueError(
+            f"{name} must be at most {_MAX_WHOLE_STEPS:.0e} time steps dt = {dt} s, got "
+            f"{given!s} s ({ratio:.3g} steps)")
     steps = round(ratio)
     if abs(ratio - steps) > rtol * max(1.0, abs(ratio)):
         raise ValueError(
@@ -151,6 +216,11 @@ def whole_steps(name: str, value: float, dt: float) -> int:
             f"being {math.floor(ratio) * dt:.10g} s and {math.ceil(ratio) * dt:.10g} s"
         )
     return steps
+
+
+#: Largest step count :func:`whole_steps` converts (2⁵³: beyond it a float no longer holds
+#: every whole number, so "a whole number of steps" means nothing).
+_MAX_WHOLE_STEPS = 2.0**53
 
 
 def _resolution(value: object) -> float:
