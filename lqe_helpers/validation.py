@@ -168,8 +168,10 @@ def instance(name: str, value: object, kind: type, example: str) -> object:
     if not isinstance(value, kind):
         text = repr(value)
         text = text if len(text) <= 60 else f"{text[:50]} …"
+        article = "an" if kind.__name__[0] in "AEIOU" else "a"
         raise ValueError(
-            f"{name} must be a {kind.__name__} ({example}), got {type(value).__name__} {text}")
+            f"{name} must be {article} {kind.__name__} ({example}), got "
+            f"{type(value).__name__} {text}")
     return value
 
 
