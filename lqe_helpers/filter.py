@@ -313,7 +313,11 @@ def _innovation_covariances(covariances: np.ndarray, C: np.ndarray, R: np.ndarra
     priors = np.concatenate(
         [np.broadcast_to(P0, (*batch, k, k))[..., None, :, :], covariances[..., :-1, :, :]],
         axis=-3)
-    S = C @ priors @ C.T + R[..., None, :, :]
+    m = C.shape[0]
+    # Two flat 2-D products (matmul's broadcasting machinery dominates for 3 × 3 blocks):
+    # X = P Cᵀ for every prior, then C P Cᵀ = (P Cᵀ)ᵀ Cᵀ since each P is symmetric.
+    X = (priors.reshape(-1, k) @ C.T).reshape(*priors.shape[:-1], m)
+    S = (X.mT.reshape(-1, k) @ C.T).reshape(*priors.shape[:-2], m, m) + R[..., None, :, :]
     return 0.5 * (S + S.mT)
 
 
