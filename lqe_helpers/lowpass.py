@@ -215,8 +215,12 @@ def sinusoid_mse(lowpass: LowPass, amplitude: float, frequency: float) -> Sinuso
     amplitude = validation.positive("amplitude", amplitude, "cm")
     frequency = validation.positive("frequency", frequency, "Hz")
     response = position_response(lowpass, frequency).response[..., 0]
-    return SinusoidMSE(amplitude**2 / 2.0 * np.abs(response - 1.0) ** 2,
-                       noise_variance(lowpass))
+    with np.errstate(over="ignore"):
+        systematic = amplitude * amplitude / 2.0 * np.abs(response - 1.0) ** 2
+    if not np.all(np.isfinite(systematic)):
+        raise ValueError(f"amplitude = {amplitude:g} cm is too large: its square overflows "
+                         f"the float64 range")
+    return SinusoidMSE(systematic, noise_variance(lowpass))
 
 
 def variance_exponent(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,

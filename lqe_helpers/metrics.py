@@ -72,7 +72,14 @@ def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.n
             f"estimate must be finite after burn_in_steps = {burn_in_steps}, got NaN or inf "
             f"at sample {burn_in_steps + first}; skip at least the samples with no estimate"
         )
-    return np.mean((kept - truth[burn_in_steps:]) ** 2, axis=-1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        result = np.mean((kept - truth[burn_in_steps:]) ** 2, axis=-1)
+    if not np.all(np.isfinite(result)):
+        raise ValueError(
+            f"estimate and truth differ by more than the float64 range allows squaring "
+            f"(largest magnitudes {np.max(np.abs(kept)):.3g} and {np.max(np.abs(truth)):.3g} "
+            f"cm): the squared error overflows")
+    return result
 
 
 @dataclass(frozen=True)
@@ -118,8 +125,15 @@ def mean_ci95(samples: np.ndarray) -> Interval:
             f"samples must be a 1-D array of at least 2 runs, got shape {samples.shape}"
         )
     runs = samples.size
-    mean = float(np.mean(samples))
-    half = t_critical_95(runs - 1) * float(np.std(samples, ddof=1)) / np.sqrt(runs)
+    # In units of the largest magnitude, so that samples near the float64 limit give a
+    # finite spread whenever the answer itself is finite.
+    scale = float(np.max(np.abs(samples))) or 1.0
+    unit = samples / scale
+    mean = float(np.mean(unit)) * scale
+    half = t_critical_95(runs - 1) * float(np.std(unit, ddof=1)) / np.sqrt(runs) * scale
+    if not (np.isfinite(mean - half) and np.isfinite(mean + half)):
+        raise ValueError(f"samples are too large for a float64 interval: the largest "
+                         f"magnitude is {scale:.3g}")
     return Interval(mean, mean - half, mean + half, runs)
 
 
@@ -161,6 +175,9 @@ def convergence_time(squared_error: np.ndarray, dt: float, factor: float = 2.0) 
     # Index just after the last sample outside the band (0 if none is outside).
     last_outside = n_steps - np.argmax(outside[..., ::-1], axis=-1)
     first_inside = np.where(np.any(outside, axis=-1), last_outside, 0)
+    if int(first_inside.max()) * dt > np.finfo(float).max:
+        raise ValueError(f"dt = {dt:g} s times {int(first_inside.max())} samples overflows "
+                         f"the float64 range")
     return first_inside * dt
 
 
@@ -196,6 +213,9 @@ def convergence_time_ci95(squared_errors: np.ndarray, dt: float, rng: np.random.
         raise ValueError(f"rng must be a numpy.random.Generator, got {rng!r}")
     resamples = validation.count("resamples", resamples, minimum=10)
     runs = errors.shape[0]
+    validation.check_memory(f"resamples = {resamples} with squared_errors of shape "
+                            f"{errors.shape}", 2 * resamples * (runs + errors.shape[1]),
+                            what="for the bootstrap")
     estimate = float(convergence_time(errors.mean(axis=0), dt, factor))
     counts = rng.multinomial(runs, np.full(runs, 1.0 / runs), size=resamples)
     curves = counts @ errors / runs
@@ -254,7 +274,12 @@ def fit_sinusoid(times: np.ndarray, signal: np.ndarray, frequency: float) -> Sin
             f"signal must have shape (..., {times.size}) to match times, got shape "
             f"{signal.shape}")
     omega = 2.0 * np.pi * frequency
-    basis = np.stack([np.sin(omega * times), np.cos(omega * times)], axis=1)  # (n, 2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        phases = omega * times
+    if not np.all(np.isfinite(phases)):
+        raise ValueError(f"frequency = {frequency:g} Hz times the times (up to "
+                         f"{np.max(np.abs(times)):g} s) overflows the float64 range")
+    basis = np.stack([np.sin(phases), np.cos(phases)], axis=1)  # (n, 2)
     if np.linalg.matrix_rank(basis) < 2:
         raise ValueError(
             f"times must span enough of a period of {frequency} Hz to tell sine from cosine, "

@@ -16,14 +16,18 @@ MATRIX_RTOL = 1e-8
 
 #: Largest memory (bytes) one call of the public API may allocate for its arrays: 2 GiB.
 #: The pack's largest legitimate call (notebook 04's sweep of 25 σ_p values over 300 runs
-#: of 1 000 samples) needs about 0.6 GiB; a call estimated above this limit is refused by
-#: :func:`check_memory` before anything is allocated, with a ``ValueError`` that names the
-#: parameter responsible and the estimate, instead of numpy's ``MemoryError`` (or minutes
-#: of swapping) on the shared 24 GiB machine.
+#: of 1 000 samples) peaks at 0.46 GiB (tracemalloc). A call estimated above this limit
+#: is refused by :func:`check_memory` before anything is allocated, with a ``ValueError``
+#: that names the parameter responsible and the estimate, instead of numpy's
+#: ``MemoryError`` (or minutes of swapping) on the shared 24 GiB machine.
 MEMORY_LIMIT_BYTES = 2 * 1024**3
 
 #: Bytes of one float64 number.
 FLOAT_BYTES = 8
+
+#: Copies of an input array that its checks and its caller may make (converted, absolute
+#: values, differences, results): an input is refused beyond a quarter of the limit.
+_INPUT_COPIES = 4
 
 
 def check_memory(names: str, numbers: int, copies: float = 1.0,
@@ -105,6 +109,9 @@ def _not_real(value: object) -> str | None:
         return _NOT_REAL_KINDS["b"]
     if isinstance(value, (complex, np.complexfloating)):
         return _NOT_REAL_KINDS["c"]
+    if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
+        return ("a masked array with masked entries (numpy would use the hidden values "
+                "behind the mask; pass only the valid ones)")
     if isinstance(value, (list, tuple)):
         for item in value:
             reason = _not_real(item)
@@ -245,6 +252,13 @@ def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
         raise ValueError(
             f"{name} must be a numeric array, got {_describe_raw(value)}: "
             f"{reason}")
+    size = getattr(value, "size", None)
+    if isinstance(value, np.ndarray) and isinstance(size, int):
+        # A broadcast view costs nothing to pass but as much as its size to convert or
+        # to compute with: every caller allocates at least that much.
+        # The checks below and every caller make a few temporaries of the same size.
+        check_memory(f"{name} of shape {value.shape}", size, copies=_INPUT_COPIES,
+                     what="as float64 numbers and their temporaries")
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -329,9 +343,13 @@ def covariance(name: str, value: object, size: int | None = None,
     existence of a Cholesky factor.
     """
     array = square_matrix(name, value, size)
+    check_memory(f"{name} of shape {array.shape}", 6 * array.size,
+                 what="to check it is a covariance")
     scale = np.max(np.abs(array), axis=(-2, -1), keepdims=True)
     scale = np.where(scale > 0, scale, 1.0)
-    asymmetry = np.max(np.abs(array - np.swapaxes(array, -1, -2)) / scale)
+    # Entries in [−1, 1]: the checks below cannot overflow, whatever the units.
+    unit = array / scale
+    asymmetry = np.max(np.abs(unit - np.swapaxes(unit, -1, -2)))
     if asymmetry > MATRIX_RTOL:
         raise ValueError(
             f"{name} must be symmetric, got {_describe(array)} with relative "
@@ -341,14 +359,14 @@ def covariance(name: str, value: object, size: int | None = None,
         # Cholesky succeeds exactly for (numerically) positive definite matrices, however
         # different the scales of their entries (R = diag(10⁶, 10⁻⁶) is fine).
         try:
-            np.linalg.cholesky(array)
+            np.linalg.cholesky(unit)
         except np.linalg.LinAlgError:
             raise ValueError(
                 f"{name} must be positive definite, got {_describe(array)} (no Cholesky "
                 f"factor exists)"
             ) from None
         return array
-    eigenvalues = np.linalg.eigvalsh(array) / scale[..., 0]
+    eigenvalues = np.linalg.eigvalsh(unit)
     smallest = float(np.min(eigenvalues)) if eigenvalues.size else 0.0
     if smallest < -MATRIX_RTOL:
         raise ValueError(

@@ -19,7 +19,8 @@ def test_chi2_quantile_matches_scipy(df: float, probability: float) -> None:
 @pytest.mark.parametrize(
     ("args", "message"),
     [((0.0, 2), r"^probability must be a finite number > 0, got 0.0$"),
-     ((1.0, 2), r"^probability must be in \(0, 1\), got 1.0$"),
+     ((1.0, 2), r"^probability must be in \[1e-15, 1 − 1e-15\], got 1.0$"),
+     ((0.5, 0.1), r"^df must be >= 0.5, got 0.1$"),
      ((0.5, 0), r"^df must be a finite number > 0, got 0$"),
      ((0.5, float("inf")), r"^df must be a finite number > 0, got inf$"),
      ((0.5, True), r"^df must be a number > 0, got True: a boolean")],
