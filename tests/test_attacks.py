@@ -13,8 +13,10 @@ import pytest
 from lqe_helpers import (
     cue_combination,
     distributions,
+    experiments,
     lowpass,
     metrics,
+    model,
     prediction,
     simulation,
     validation,
@@ -159,3 +161,25 @@ def test_validation_refuses_a_broadcast_view_too_large_to_compute_with() -> None
     with pytest.raises(ValueError, match=r"^signal of shape \(1000000000,\) would need about "
                                          r"29.8 GiB"):
         validation.numeric_array("signal", view)
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        # Before: NaN/inf matrices, OverflowError "(34, 'Numerical result out of range')",
+        # or an error naming R when track was given σ = 1e200 cm.
+        (lambda: model.transition_matrix(1e308), r"^dt = 1e\+308 s give numbers beyond"),
+        (lambda: model.jerk_input_matrix(1e200), r"^dt = 1e\+200 s give numbers beyond"),
+        (lambda: model.process_noise_covariance(0.01, 1e308),
+         r"^jerk_std = 1e\+308 cm/s³ with dt = 0.01 s give numbers beyond"),
+        (lambda: model.measurement_noise_covariance([1.5, 1e200]),
+         r"^sigmas \(largest 1e\+200 cm, smallest 1.5 cm\) give numbers beyond"),
+        (lambda: model.measurement_noise_covariance([1e-300]), r"^sigmas .* give numbers beyond"),
+        (lambda: experiments.track(DEFAULT, sigmas=[1e200]), r"^sigmas .* give numbers beyond"),
+        (lambda: model.diagonal_covariance(1.0, size=10**6), r"^size = 1000000 with variance "
+                                                             r"of shape \(\) would need"),
+    ],
+)
+def test_model_matrices_name_the_input_that_leaves_the_float_range(call, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        call()
