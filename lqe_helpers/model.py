@@ -79,6 +79,7 @@ def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
         Q with units cm², cm²/s, cm²/s², ... (row i, column j: cm²/s^(i+j)).
     """
     jerk_std = validation.non_negative("jerk_std", jerk_std, "cm/s³")
+    dt = validation.positive("dt", dt, "s")
     g = jerk_input_matrix(dt)
     return _in_range(f"jerk_std = {jerk_std:g} cm/s³ with dt = {dt:g} s",
                      lambda: jerk_std**2 * (g @ g.T))
