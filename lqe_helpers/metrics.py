@@ -171,7 +171,8 @@ def convergence_time(squared_error: np.ndarray, dt: float, factor: float = 2.0) 
         raise ValueError(f"factor must be > 1, got {factor}")
     n_steps = curve.shape[-1]
     steady = np.mean(curve[..., n_steps // 2:], axis=-1, keepdims=True)
-    outside = curve > factor * steady
+    with np.errstate(over="ignore"):  # a threshold of inf leaves nothing outside
+        outside = curve > factor * steady
     # Index just after the last sample outside the band (0 if none is outside).
     last_outside = n_steps - np.argmax(outside[..., ::-1], axis=-1)
     first_inside = np.where(np.any(outside, axis=-1), last_outside, 0)
