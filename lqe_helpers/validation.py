@@ -347,8 +347,10 @@ def covariance(name: str, value: object, size: int | None = None,
                  what="to check it is a covariance")
     scale = np.max(np.abs(array), axis=(-2, -1), keepdims=True)
     scale = np.where(scale > 0, scale, 1.0)
-    # Entries in [−1, 1]: the checks below cannot overflow, whatever the units.
-    unit = array / scale
+    # Entries in [−1, 1]: the checks below cannot overflow, whatever the units. A matrix
+    # whose largest entry is subnormal (below 2.2e-308) has lost its relative precision
+    # and is zero for every purpose here (e.g. Q of a jerk of 1e-158 cm/s³).
+    unit = np.where(scale >= np.finfo(float).tiny, array / scale, 0.0)
     asymmetry = np.max(np.abs(unit - np.swapaxes(unit, -1, -2)))
     if asymmetry > MATRIX_RTOL:
         raise ValueError(

@@ -114,3 +114,13 @@ def test_check_memory_returns_the_estimate_within_the_limit_and_refuses_beyond()
     # Python ints: a size no machine could hold is estimated, not overflowed.
     with pytest.raises(ValueError, match=r"would need about 7.45e\+1[0-9] GiB"):
         validation.check_memory("n_steps = 10**20", validation.elements((10**20, 10)))
+
+
+def test_a_covariance_of_subnormal_numbers_counts_as_zero() -> None:
+    # Found by hypothesis: Q for a jerk of 1e-158 cm/s³ has entries near 1e-328, whose
+    # rounding made the scaled matrix look indefinite.
+    from lqe_helpers import model
+
+    Q = model.process_noise_covariance(0.01, 1.1344280960175625e-158)
+    assert np.max(np.abs(Q)) < np.finfo(float).tiny
+    np.testing.assert_array_equal(validation.covariance("Q", Q, size=3), Q)
