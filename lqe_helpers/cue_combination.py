@@ -39,8 +39,8 @@ def reliability_weights(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
     ndarray, shape (..., m)
         Weights in [0, 1] summing to one along the last axis.
     """
-    reliabilities = 1.0 / _sigmas(sigmas) ** 2
-    return reliabilities / reliabilities.sum(axis=-1, keepdims=True)
+    relative = _relative_reliabilities(_sigmas(sigmas))
+    return relative / relative.sum(axis=-1, keepdims=True)
 
 
 def combined_sigma(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -56,4 +56,15 @@ def combined_sigma(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
     ndarray, shape (...)
         Never above the smallest σ_i: adding a sense never makes the combination worse.
     """
-    return 1.0 / np.sqrt(np.sum(1.0 / _sigmas(sigmas) ** 2, axis=-1))
+    sigmas = _sigmas(sigmas)
+    smallest = sigmas.min(axis=-1)
+    return smallest / np.sqrt(np.sum(_relative_reliabilities(sigmas), axis=-1))
+
+
+def _relative_reliabilities(sigmas: np.ndarray) -> np.ndarray:
+    """Reliabilities ``1/σ_i²`` in units of the largest, ``(σ_min/σ_i)²`` in (0, 1].
+
+    The same ratios as ``1/σ²`` without its overflow for σ near 1e-300 cm or underflow
+    to 0/0 for σ near 1e200 cm.
+    """
+    return (sigmas.min(axis=-1, keepdims=True) / sigmas) ** 2

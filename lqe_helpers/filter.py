@@ -25,12 +25,18 @@ class FilterResult:
     estimate_covariances : ndarray, shape (..., n, k, k)
         ``(I − K C) P_j``: the filter's own covariance of ``ẑ_j`` itself, the value to
         set beside an empirical mean squared error.
+    innovation_covariances : ndarray, shape (..., n, m, m), or None
+        ``S_j = C P_j Cᵀ + R``: the covariance the filter expects of the innovation
+        ``y_j − C A ẑ_{j−1}`` (cm²), with ``P_j`` the prior before ``y_j`` (P0 for the
+        first reading). :func:`~lqe_helpers.metrics.innovations` pairs it with the
+        innovations themselves. None in a result assembled by hand.
     """
 
     estimates: np.ndarray
     gains: np.ndarray
     covariances: np.ndarray
     estimate_covariances: np.ndarray
+    innovation_covariances: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -270,18 +276,42 @@ def kalman_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
         y=y.shape[:-2], R=R.shape[:-2], z0=z0.shape[:-1], P0=P0.shape[:-2], u=input_batch
     )
 
-    sequence = _covariance_sequence(n_steps, A, C, Q, R, P0)
-    gains = sequence.gains
-    # ẑ_j = M_j ẑ_{j-1} + K_j y_j + (I − K_j C) B u_j with M_j = A − K_j C A:
-    # Tutorial eq. (5) rearranged so that the data enter once, for all j together.
-    transitions_T = (A - gains @ (C @ A)).mT
-    inputs = [(y, gains)]
-    if B is not None:
-        inputs.append((u, (np.eye(k) - gains @ C) @ B))
-    if transitions_T.ndim == 3:
-        estimates = _estimates_shared_gains(inputs, z0, transitions_T, batch)
-    else:
-        estimates = _estimates_swept_gains(inputs, z0, transitions_T, batch)
+    covariance_batch = np.broadcast_shapes(R.shape[:-2], P0.shape[:-2])
+    inputs_per_run = 0 if B is None else 2 * B.shape[1]
+    validation.check_memory(
+        f"y of shape {y.shape}, R of shape {R.shape}, z0 of shape {z0.shape} and P0 of shape "
+        f"{P0.shape}",
+        n_steps * (validation.elements(covariance_batch) * (3 * k * m + 6 * k * k + 2 * m * m)
+                   + validation.elements(batch) * (4 * k + 2 * m + inputs_per_run)),
+        what="for the estimates, gains and covariances")
+
+    # Overflow is detected below and reported as a ValueError naming the inputs, not
+    # left to NaN and RuntimeWarnings.
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        sequence = _covariance_sequence(n_steps, A, C, Q, R, P0)
+        _refuse_overflow("the covariance P", sequence.covariances, A=A, Q=Q, R=R, P0=P0)
+        _refuse_overflow("the gain K", sequence.gains, A=A, Q=Q, R=R, P0=P0)
+        gains = sequence.gains
+        # ẑ_j = M_j ẑ_{j-1} + K_j y_j + (I − K_j C) B u_j with M_j = A − K_j C A:
+        # Tutorial eq. (5) rearranged so that the data enter once, for all j together.
+        transitions_T = (A - gains @ (C @ A)).mT
+        inputs = [(y, gains)]
+        if B is not None:
+            inputs.append((u, (np.eye(k) - gains @ C) @ B))
+        if transitions_T.ndim == 3:
+            estimates = _estimates_shared_gains(inputs, z0, transitions_T, batch)
+        else:
+            estimates = _estimates_swept_gains(inputs, z0, transitions_T, batch)
+        innovation_covariances = _innovation_covariances(sequence.covariances, C, R, P0)
+        _refuse_overflow("the innovation covariance S = C P Cᵀ + R", innovation_covariances,
+                         C=C, R=R, P0=P0)
+    # A NaN or inf never turns finite again in ẑ ← M ẑ + K y, so the last estimate of
+    # each run tells whether any overflowed (and costs nothing next to the filter).
+    if not np.all(np.isfinite(estimates[..., -1, :])):
+        named = {"y": y, "A": A, "C": C, "z0": z0} | ({} if B is None else {"B": B, "u": u})
+        raise ValueError(
+            f"the estimates overflowed the float64 range (reached inf or NaN): the inputs "
+            f"are too large together; their largest magnitudes are {_largest(named)}")
 
     def full(array: np.ndarray) -> np.ndarray:
         return np.broadcast_to(array, (*batch, *array.shape[-3:]))
@@ -291,7 +321,46 @@ def kalman_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray,
         gains=full(gains),
         covariances=full(sequence.covariances),
         estimate_covariances=full(sequence.estimate_covariances),
+        innovation_covariances=full(innovation_covariances),
     )
+
+
+def _largest(named: dict[str, np.ndarray]) -> str:
+    """``"A 1e+200, Q 0.0023, …"``: the largest magnitude of each named array."""
+    return ", ".join(f"{name} {float(np.max(np.abs(value))):.3g}"
+                     for name, value in named.items())
+
+
+def _refuse_overflow(what: str, stack: np.ndarray, **named: np.ndarray) -> None:
+    """A ``ValueError`` naming the inputs if ``stack`` (..., n, a, b) holds inf or NaN."""
+    bad = ~np.isfinite(stack)
+    if np.any(bad):
+        step = int(np.argmax(np.any(bad, axis=(-2, -1)).reshape(-1, stack.shape[-3])
+                             .any(axis=0)))
+        raise ValueError(
+            f"{what} overflowed the float64 range (reached inf or NaN) at step {step}: "
+            f"{', '.join(named)} are too large (or R too small) together; their largest "
+            f"magnitudes are {_largest(named)}")
+
+
+def _innovation_covariances(covariances: np.ndarray, C: np.ndarray, R: np.ndarray,
+                            P0: np.ndarray) -> np.ndarray:
+    """``S_j = C P_j Cᵀ + R`` for every step, from the priors ``P0, P_1, …, P_{n−1}``.
+
+    ``covariances`` (..., n, k, k) holds the prior of the *next* step, so the prior of
+    step j is ``covariances[j − 1]`` and P0 for j = 0. One batched product over the
+    covariance batch (not over Monte Carlo runs): microseconds next to the filter.
+    """
+    batch, k = covariances.shape[:-3], covariances.shape[-1]
+    priors = np.concatenate(
+        [np.broadcast_to(P0, (*batch, k, k))[..., None, :, :], covariances[..., :-1, :, :]],
+        axis=-3)
+    m = C.shape[0]
+    # Two flat 2-D products (matmul's broadcasting machinery dominates for 3 × 3 blocks):
+    # X = P Cᵀ for every prior, then C P Cᵀ = (P Cᵀ)ᵀ Cᵀ since each P is symmetric.
+    X = (priors.reshape(-1, k) @ C.T).reshape(*priors.shape[:-1], m)
+    S = (X.mT.reshape(-1, k) @ C.T).reshape(*priors.shape[:-2], m, m) + R[..., None, :, :]
+    return 0.5 * (S + S.mT)
 
 
 def _estimates_shared_gains(inputs: list[tuple[np.ndarray, np.ndarray]], z0: np.ndarray,

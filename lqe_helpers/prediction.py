@@ -35,9 +35,18 @@ def predict_ahead(estimates: np.ndarray, A: np.ndarray, steps: int) -> np.ndarra
     if A.ndim != 2:
         raise ValueError(f"A must have shape ({k}, {k}), got shape {A.shape}")
     steps = validation.count("steps", steps, minimum=0, maximum=n_steps - 1)
-    ahead = np.linalg.matrix_power(A, steps)
-    out = np.full(estimates.shape, np.nan)
-    out[..., steps:, :] = estimates[..., : n_steps - steps, :] @ ahead.T
+    validation.check_memory(f"estimates of shape {estimates.shape}", 2 * estimates.size,
+                            what="for the predictions")
+    with np.errstate(over="ignore", invalid="ignore"):
+        ahead = np.linalg.matrix_power(A, steps)
+        out = np.full(estimates.shape, np.nan)
+        out[..., steps:, :] = estimates[..., : n_steps - steps, :] @ ahead.T
+    if not np.all(np.isfinite(out[..., steps:, :])):
+        raise ValueError(
+            f"the predictions overflowed the float64 range (reached inf or NaN): A^steps with "
+            f"steps = {steps} and the estimates are too large together (largest magnitudes: "
+            f"A {np.max(np.abs(A)):.3g}, A^steps {np.max(np.abs(ahead)):.3g}, estimates "
+            f"{np.max(np.abs(estimates)):.3g})")
     return out
 
 
@@ -64,19 +73,38 @@ def propagate_covariance(P0: np.ndarray, A: np.ndarray, Q: np.ndarray,
     ndarray, shape (..., steps + 1, k, k)
         ``P(0) … P(steps)``.
     """
+    return _propagate(validation.covariance("P0", P0), A, Q, steps, "steps")
+
+
+def _propagate(P: np.ndarray, A: np.ndarray, Q: np.ndarray, steps: int,
+               steps_name: str) -> np.ndarray:
+    """:func:`propagate_covariance` of a validated ``P``; ``steps_name`` is blamed for size."""
     A = validation.square_matrix("A", A)
     if A.ndim != 2:
         raise ValueError(f"A must have shape (k, k), got shape {A.shape}")
     k = A.shape[0]
-    P = validation.covariance("P0", P0, size=k)
+    if P.shape[-2:] != (k, k):
+        raise ValueError(f"P0 must have trailing shape ({k}, {k}) like A, got shape {P.shape}")
     Q = validation.covariance("Q", Q, size=k)
+    if Q.ndim != 2:
+        raise ValueError(f"Q must have shape ({k}, {k}), got shape {Q.shape}")
     steps = validation.count("steps", steps, minimum=0)
-    out = [P]
-    for _ in range(steps):
-        P = A @ P @ A.T + Q
-        P = 0.5 * (P + P.mT)
-        out.append(P)
-    return np.stack(out, axis=-3)
+    validation.check_memory(f"{steps_name} ({steps} steps) with a start of shape {P.shape}",
+                            (steps + 2) * P.size, what="for the covariances")
+    out = np.empty((*P.shape[:-2], steps + 1, k, k))
+    out[..., 0, :, :] = P
+    with np.errstate(over="ignore", invalid="ignore"):
+        for step in range(1, steps + 1):
+            P = A @ P @ A.T + Q
+            P = 0.5 * (P + P.mT)
+            out[..., step, :, :] = P
+    if not np.all(np.isfinite(P)):  # inf or NaN never turns finite again here
+        raise ValueError(
+            f"the covariance overflowed the float64 range (reached inf or NaN) within "
+            f"{steps} steps: A, Q and the start are too large together (largest magnitudes: "
+            f"A {np.max(np.abs(A)):.3g}, Q {np.max(np.abs(Q)):.3g}, start "
+            f"{np.max(np.abs(out[..., 0, :, :])):.3g})")
+    return out
 
 
 @dataclasses.dataclass(frozen=True)
@@ -128,15 +156,26 @@ def open_loop(scenario: Scenario, estimate: np.ndarray, covariance: np.ndarray,
     estimate = validation.finite_array("estimate", estimate, min_ndim=1)
     if estimate.shape != (3,):
         raise ValueError(f"estimate must have shape (3,), got shape {estimate.shape}")
+    covariance = validation.covariance("covariance", covariance, size=3)
     validation.positive("duration", duration, "s")
     # The value as given, so that a float32 duration is judged at float32 precision.
     steps = validation.whole_steps("duration", duration, scenario.dt)
-    covariances = propagate_covariance(covariance, scenario.A, scenario.Q, steps)
+    duration_text = f"duration = {duration} s"
+    batch_text = (f" with covariance of shape {covariance.shape}" if covariance.ndim > 2
+                  else "")
+    validation.check_memory(f"{duration_text} ({steps} steps of {scenario.dt} s){batch_text}",
+                            (steps + 2) * (covariance.size + 4), what="for the prediction")
+    covariances = _propagate(covariance, scenario.A, scenario.Q, steps, duration_text)
     # (..., steps + 1, 3, 3) for a (..., 3, 3) start: P(0) … P(steps) along axis -3.
     means = np.empty((steps + 1, 3))
     means[0] = estimate
-    for k in range(steps):
-        means[k + 1] = scenario.A @ means[k]
+    with np.errstate(over="ignore", invalid="ignore"):
+        for k in range(steps):
+            means[k + 1] = scenario.A @ means[k]
+    if not np.all(np.isfinite(means[-1])):
+        raise ValueError(
+            f"the predicted mean overflowed the float64 range within {duration_text}: "
+            f"estimate's largest magnitude is {np.max(np.abs(estimate)):.3g}")
     return OpenLoop(np.arange(steps + 1) * scenario.dt, means, covariances)
 
 

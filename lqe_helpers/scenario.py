@@ -50,7 +50,14 @@ def matched_jerk_std(amplitude: float, frequency: float, dt: float,
     period_fraction = validation.positive("period_fraction", period_fraction)
     omega = 2.0 * np.pi * frequency
     time_scale = period_fraction / frequency
-    return float(amplitude * omega**2 / np.sqrt(dt * time_scale))
+    with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+        value = float(amplitude * omega**2 / np.sqrt(dt * time_scale))
+    if not (np.isfinite(value) and value > 0):
+        raise ValueError(
+            f"amplitude, frequency, dt and period_fraction give σ_j = A ω² / √(Δt T) outside "
+            f"the float64 range, got amplitude = {amplitude:g} cm, frequency = {frequency:g} "
+            f"Hz, dt = {dt:g} s, period_fraction = {period_fraction:g}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -98,11 +105,15 @@ class Scenario:
     def __post_init__(self) -> None:
         validation.positive("dt", self.dt, "s")
         validation.positive("duration", self.duration, "s")
-        validation.whole_steps("duration", self.duration, self.dt)
+        steps = validation.whole_steps("duration", self.duration, self.dt)
+        validation.check_memory(
+            f"duration = {self.duration} s ({steps} steps of dt = {self.dt} s)",
+            _NUMBERS_PER_STEP * steps,
+            what="for one run's truth, readings, estimates, gains and covariances")
         if self.duration < 2 * self.dt:
             raise ValueError(
-                f"duration must be at least two time steps ({2 * self.dt} s), got {self.duration}"
-            )
+                f"duration must be at least two time steps of dt = {self.dt} s, got "
+                f"{self.duration}")
         validation.positive("amplitude", self.amplitude, "cm")
         validation.positive("frequency", self.frequency, "Hz")
         if self.frequency >= 0.5 / self.dt:
@@ -204,10 +215,20 @@ class Scenario:
         of a Monte Carlo batch is the single run shown in the figures.
         """
         sensors = model.sensor_names(sensors)
+        if runs is not None:
+            runs = validation.count("runs", runs, minimum=1)
+            validation.check_memory(f"runs = {runs}",
+                                    2 * runs * self.n_steps * len(model.SENSORS),
+                                    what=f"for the noise of {self.n_steps} steps")
         rng = np.random.default_rng(self.seed)
         noise = simulation.unit_noise(rng, self.n_steps, len(model.SENSORS), runs=runs)
         return noise[..., [model.SENSORS.index(s) for s in sensors]]
 
+
+#: Float64 numbers one simulated and filtered run holds per time step (times, truth,
+#: noise, readings, estimates, gains, covariances and their temporaries), for the size
+#: check of :attr:`Scenario.duration`.
+_NUMBERS_PER_STEP = 64
 
 #: The pack's scenario: every notebook starts from it.
 DEFAULT = Scenario()

@@ -27,7 +27,13 @@ def sinusoid_states(times: np.ndarray, amplitude: float, frequency: float) -> np
     times = validation.finite_array("times", times, min_ndim=1)
     amplitude = validation.positive("amplitude", amplitude, "cm")
     frequency = validation.positive("frequency", frequency, "Hz")
+    validation.check_memory(f"times of shape {times.shape}", 5 * times.size,
+                            what="for the states")
     omega = 2.0 * np.pi * frequency
+    if not np.isfinite(amplitude * omega**2):
+        raise ValueError(
+            f"amplitude and frequency give an acceleration amplitude A (2π f)² beyond the "
+            f"float64 range, got amplitude = {amplitude:g} cm and frequency = {frequency:g} Hz")
     phase = omega * times
     return np.stack(
         [amplitude * np.sin(phase),
@@ -69,6 +75,11 @@ def unit_noise(rng: np.random.Generator, n_steps: int, n_sensors: int,
     n_steps = validation.count("n_steps", n_steps, minimum=1)
     n_sensors = validation.count("n_sensors", n_sensors, minimum=1)
     shape = (n_steps,) if runs is None else (validation.count("runs", runs, minimum=1), n_steps)
+    validation.check_memory(
+        ", ".join(f"{name} = {value}" for name, value in
+                  (("runs", runs), ("n_steps", n_steps), ("n_sensors", n_sensors))
+                  if value is not None),
+        2 * validation.elements(shape) * n_sensors, what="for the noise")
     streams = rng.spawn(n_sensors)
     return np.stack([stream.standard_normal(shape) for stream in streams], axis=-1)
 
@@ -101,7 +112,19 @@ def measure(positions: np.ndarray, noise: np.ndarray, sigmas: np.ndarray) -> np.
             f"positions (n,), noise (..., n, m) and sigmas (..., m) must agree on n and m, "
             f"got shapes {positions.shape}, {noise.shape} and {sigmas.shape}"
         )
-    return positions[..., :, None] + sigmas[..., None, :] * noise
+    shape = np.broadcast_shapes(positions[..., :, None].shape, sigmas[..., None, :].shape,
+                                noise.shape)
+    validation.check_memory(
+        f"positions of shape {positions.shape}, noise of shape {noise.shape} and sigmas of "
+        f"shape {sigmas.shape}", 2 * validation.elements(shape), what="for the readings")
+    with np.errstate(over="ignore", invalid="ignore"):
+        readings = positions[..., :, None] + sigmas[..., None, :] * noise
+    if not np.all(np.isfinite(readings)):
+        raise ValueError(
+            f"the readings overflowed the float64 range: positions, sigmas and noise are too "
+            f"large together (largest magnitudes {np.max(np.abs(positions)):.3g} cm, "
+            f"{np.max(sigmas):.3g} cm and {np.max(np.abs(noise)):.3g})")
+    return readings
 
 
 def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
@@ -134,6 +157,8 @@ def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
             f"axis must name an axis of signal with shape {signal.shape}, got {axis!r}"
         ) from None
     steps = validation.count("steps", steps, minimum=0, maximum=n_steps - 1)
+    validation.check_memory(f"signal of shape {signal.shape}", 2 * signal.size,
+                            what="for the delayed signal")
     moved = np.moveaxis(signal, axis, 0)
     out = np.full(moved.shape, np.nan)
     out[steps:] = moved[: n_steps - steps]
@@ -186,11 +211,24 @@ def simulate_model_states(rng: np.random.Generator, A: np.ndarray, Q: np.ndarray
         raise ValueError(f"mean0 must have shape ({k},) like A, got shape {mean0.shape}")
     n_steps = validation.count("n_steps", n_steps, minimum=1)
     runs = validation.count("runs", runs, minimum=1)
-    first = rng.multivariate_normal(A @ mean0, P0, size=runs, method="eigh")
-    # One kick per transition: n − 1 of them, into samples 1 … n − 1.
-    kicks = rng.multivariate_normal(np.zeros(k), Q, size=(runs, n_steps - 1), method="eigh")
-    states = np.empty((runs, n_steps, k))
-    states[:, 0] = first
-    for j in range(1, n_steps):
-        states[:, j] = states[:, j - 1] @ A.T + kicks[:, j - 1]
+    validation.check_memory(f"runs = {runs} and n_steps = {n_steps}",
+                            3 * runs * n_steps * k, what="for the states")
+    with np.errstate(over="ignore", invalid="ignore"):
+        # P0 and Q passed validation.covariance's scale-free check; numpy's own check uses
+        # an absolute tolerance that cries wolf for Q ~ 1e200 cm², so it is switched off.
+        first = rng.multivariate_normal(A @ mean0, P0, size=runs, method="eigh",
+                                        check_valid="ignore")
+        # One kick per transition: n − 1 of them, into samples 1 … n − 1.
+        kicks = rng.multivariate_normal(np.zeros(k), Q, size=(runs, n_steps - 1), method="eigh",
+                                        check_valid="ignore")
+        states = np.empty((runs, n_steps, k))
+        states[:, 0] = first
+        for j in range(1, n_steps):
+            states[:, j] = states[:, j - 1] @ A.T + kicks[:, j - 1]
+    if not np.all(np.isfinite(states[:, -1])):  # inf or NaN stays non-finite
+        raise ValueError(
+            f"the simulated states overflowed the float64 range (reached inf or NaN): A, Q, "
+            f"mean0 and P0 are too large together over {n_steps} steps (largest magnitudes: "
+            f"A {np.max(np.abs(A)):.3g}, Q {np.max(np.abs(Q)):.3g}, mean0 "
+            f"{np.max(np.abs(mean0)):.3g}, P0 {np.max(np.abs(P0)):.3g})")
     return states

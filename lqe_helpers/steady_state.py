@@ -96,9 +96,17 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
         )
 
     batch = R.shape[:-2]
+    validation.check_memory(f"R of shape {R.shape}",
+                            16 * validation.elements(batch) * max(k, m) ** 2,
+                            what="for the Riccati doubling")
     identity = np.eye(k)
     A_i = np.broadcast_to(A.T, (*batch, k, k))
     G_i = C.T @ np.linalg.solve(R, np.broadcast_to(C, (*batch, m, k)))
+    if np.any(C) and np.any(np.all(G_i == 0, axis=(-2, -1))):
+        raise ValueError(
+            f"C and R must leave the readings some information, got Cᵀ R⁻¹ C = 0 in float64 "
+            f"(C's largest magnitude {np.max(np.abs(C)):.3g}, R's {np.max(np.abs(R)):.3g}): "
+            f"the sensors are worthless at this scale")
     H_i = np.broadcast_to(Q, (*batch, k, k))
     change = np.inf
     for doubling in range(1, max_doublings + 1):
@@ -114,8 +122,10 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
                 # Not expected once (A, C) is detectable; kept so that a numerical
                 # breakdown is reported, never returned as a steady state.
                 f"the Riccati recursion has no finite fixed point for these A, C, Q and R "
-                f"(P overflowed at doubling step {doubling}): C must observe, and Q must "
-                f"drive, every mode of A that does not decay"
+                f"(P overflowed at doubling step {doubling}; largest magnitudes: A "
+                f"{np.max(np.abs(A)):.3g}, C {np.max(np.abs(C)):.3g}, Q {np.max(np.abs(Q)):.3g}, "
+                f"R {np.max(np.abs(R)):.3g}): their sizes leave the float64 range, or C does "
+                f"not observe, or Q does not drive, every mode of A that does not decay"
             )
         change = np.max(np.abs(H_next - H_i)) / max(np.max(np.abs(H_next)), 1e-300)
         A_i, G_i, H_i = A_next, 0.5 * (G_next + G_next.mT), H_next
@@ -169,10 +179,13 @@ def undetectable_modes(A: np.ndarray, C: np.ndarray) -> tuple[np.ndarray, np.nda
         (e = 0 when (A, C) is detectable).
     """
     k = A.shape[0]
-    blocks, block = [], C
+    # The observable subspace of (A/s, C) is that of (A, C): scaling A by its largest
+    # magnitude keeps C A^(k−1) finite for any A.
+    scale = float(np.max(np.abs(A))) or 1.0
+    blocks, block = [], C / (float(np.max(np.abs(C))) or 1.0)
     for _ in range(k):
         blocks.append(block)
-        block = block @ A
+        block = block @ (A / scale)
     _, singular, vt = np.linalg.svd(np.vstack(blocks))
     largest = singular[0] if singular.size else 0.0
     rank = int(np.sum(singular > OBSERVABILITY_RTOL * largest)) if largest > 0 else 0

@@ -14,6 +14,71 @@ import numpy as np
 #: Relative tolerance for "symmetric" and "positive semidefinite" checks.
 MATRIX_RTOL = 1e-8
 
+#: Largest memory (bytes) one call of the public API may allocate for its arrays: 2 GiB.
+#: The pack's largest legitimate call (notebook 04's sweep of 25 σ_p values over 300 runs
+#: of 1 000 samples) peaks at 0.46 GiB (tracemalloc). A call estimated above this limit
+#: is refused by :func:`check_memory` before anything is allocated, with a ``ValueError``
+#: that names the parameter responsible and the estimate, instead of numpy's
+#: ``MemoryError`` (or minutes of swapping) on the shared 24 GiB machine.
+MEMORY_LIMIT_BYTES = 2 * 1024**3
+
+#: Bytes of one float64 number.
+FLOAT_BYTES = 8
+
+#: Copies of an input array that its checks and its caller may make (converted, absolute
+#: values, differences, results): an input is refused beyond a quarter of the limit.
+_INPUT_COPIES = 4
+
+
+def check_memory(names: str, numbers: int, copies: float = 1.0,
+                 what: str = "") -> int:
+    """Refuse a call that would allocate more than :data:`MEMORY_LIMIT_BYTES`.
+
+    Parameters
+    ----------
+    names : str
+        The parameter(s) responsible, as the caller wrote them, with their values, e.g.
+        ``"runs = 10000000"`` or ``"y of shape (300, 1000, 2) and R of shape (25, 2, 2)"``.
+    numbers : int
+        How many float64 numbers the largest set of arrays alive at once holds (a Python
+        int: no overflow, however absurd the size).
+    copies : float
+        Multiplier for temporaries of the same size (e.g. 2 when a list of steps is
+        stacked into a new array).
+    what : str
+        What the memory is for, quoted in the message (e.g. ``"the estimates"``).
+
+    Returns
+    -------
+    int
+        The estimate in bytes, when it is within the limit.
+
+    Raises
+    ------
+    ValueError
+        ``"<names> would need about 7.5 GiB <what>, more than the limit of 2 GiB
+        (validation.MEMORY_LIMIT_BYTES)"``, raised before anything is allocated.
+    """
+    estimate = math.ceil(int(numbers) * FLOAT_BYTES * copies)
+    if estimate > MEMORY_LIMIT_BYTES:
+        purpose = f" {what}" if what else ""
+        raise ValueError(
+            f"{names} would need about {_bytes_text(estimate)}{purpose}, more than the limit "
+            f"of {_bytes_text(MEMORY_LIMIT_BYTES)} (validation.MEMORY_LIMIT_BYTES); use fewer "
+            f"runs, steps or sweep values, or split the call")
+    return estimate
+
+
+def _bytes_text(size: int) -> str:
+    """A byte count in GiB, with a power of ten when it is astronomically large."""
+    gib = size / 1024**3
+    return f"{gib:.3g} GiB" if gib < 1e6 else f"{gib:.2e} GiB"
+
+
+def elements(shape: tuple[int, ...]) -> int:
+    """Number of entries of an array of ``shape``, as an exact Python int."""
+    return math.prod(int(d) for d in shape)
+
 
 def _describe(value: object) -> str:
     """Short text for a received value: the value itself, or the shape of an array."""
@@ -44,6 +109,9 @@ def _not_real(value: object) -> str | None:
         return _NOT_REAL_KINDS["b"]
     if isinstance(value, (complex, np.complexfloating)):
         return _NOT_REAL_KINDS["c"]
+    if isinstance(value, np.ma.MaskedArray) and np.ma.is_masked(value):
+        return ("a masked array with masked entries (numpy would use the hidden values "
+                "behind the mask; pass only the valid ones)")
     if isinstance(value, (list, tuple)):
         for item in value:
             reason = _not_real(item)
@@ -107,8 +175,10 @@ def instance(name: str, value: object, kind: type, example: str) -> object:
     if not isinstance(value, kind):
         text = repr(value)
         text = text if len(text) <= 60 else f"{text[:50]} …"
+        article = "an" if kind.__name__[0] in "AEIOU" else "a"
         raise ValueError(
-            f"{name} must be a {kind.__name__} ({example}), got {type(value).__name__} {text}")
+            f"{name} must be {article} {kind.__name__} ({example}), got "
+            f"{type(value).__name__} {text}")
     return value
 
 
@@ -143,6 +213,10 @@ def whole_steps(name: str, value: float, dt: float) -> int:
     value = finite_number(name, value, "s")
     dt = positive("dt", dt, "s")
     ratio = value / dt
+    if not abs(ratio) < _MAX_WHOLE_STEPS:  # also catches inf from 1e308 / 0.01
+        raise ValueError(
+            f"{name} must be at most {_MAX_WHOLE_STEPS:.0e} time steps dt = {dt} s, got "
+            f"{given!s} s ({ratio:.3g} steps)")
     steps = round(ratio)
     if abs(ratio - steps) > rtol * max(1.0, abs(ratio)):
         raise ValueError(
@@ -151,6 +225,11 @@ def whole_steps(name: str, value: float, dt: float) -> int:
             f"being {math.floor(ratio) * dt:.10g} s and {math.ceil(ratio) * dt:.10g} s"
         )
     return steps
+
+
+#: Largest step count :func:`whole_steps` converts (2⁵³: beyond it a float no longer holds
+#: every whole number, so "a whole number of steps" means nothing).
+_MAX_WHOLE_STEPS = 2.0**53
 
 
 def _resolution(value: object) -> float:
@@ -173,6 +252,13 @@ def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
         raise ValueError(
             f"{name} must be a numeric array, got {_describe_raw(value)}: "
             f"{reason}")
+    size = getattr(value, "size", None)
+    if isinstance(value, np.ndarray) and isinstance(size, int):
+        # A broadcast view costs nothing to pass but as much as its size to convert or
+        # to compute with: every caller allocates at least that much.
+        # The checks below and every caller make a few temporaries of the same size.
+        check_memory(f"{name} of shape {value.shape}", size, copies=_INPUT_COPIES,
+                     what="as float64 numbers and their temporaries")
     try:
         array = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -257,9 +343,15 @@ def covariance(name: str, value: object, size: int | None = None,
     existence of a Cholesky factor.
     """
     array = square_matrix(name, value, size)
+    check_memory(f"{name} of shape {array.shape}", 6 * array.size,
+                 what="to check it is a covariance")
     scale = np.max(np.abs(array), axis=(-2, -1), keepdims=True)
     scale = np.where(scale > 0, scale, 1.0)
-    asymmetry = np.max(np.abs(array - np.swapaxes(array, -1, -2)) / scale)
+    # Entries in [−1, 1]: the checks below cannot overflow, whatever the units. A matrix
+    # whose largest entry is subnormal (below 2.2e-308) has lost its relative precision
+    # and is zero for every purpose here (e.g. Q of a jerk of 1e-158 cm/s³).
+    unit = np.where(scale >= np.finfo(float).tiny, array / scale, 0.0)
+    asymmetry = np.max(np.abs(unit - np.swapaxes(unit, -1, -2)))
     if asymmetry > MATRIX_RTOL:
         raise ValueError(
             f"{name} must be symmetric, got {_describe(array)} with relative "
@@ -269,14 +361,14 @@ def covariance(name: str, value: object, size: int | None = None,
         # Cholesky succeeds exactly for (numerically) positive definite matrices, however
         # different the scales of their entries (R = diag(10⁶, 10⁻⁶) is fine).
         try:
-            np.linalg.cholesky(array)
+            np.linalg.cholesky(unit)
         except np.linalg.LinAlgError:
             raise ValueError(
                 f"{name} must be positive definite, got {_describe(array)} (no Cholesky "
                 f"factor exists)"
             ) from None
         return array
-    eigenvalues = np.linalg.eigvalsh(array) / scale[..., 0]
+    eigenvalues = np.linalg.eigvalsh(unit)
     smallest = float(np.min(eigenvalues)) if eigenvalues.size else 0.0
     if smallest < -MATRIX_RTOL:
         raise ValueError(

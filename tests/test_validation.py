@@ -100,3 +100,27 @@ def test_whole_steps_accepts_rounding_of_the_given_precision(value, dt, steps: i
 def test_whole_steps_refuses_and_says_how_many_steps(value, dt, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         validation.whole_steps("delay", value, dt)
+
+
+def test_check_memory_returns_the_estimate_within_the_limit_and_refuses_beyond() -> None:
+    assert validation.check_memory("runs = 3", 1000) == 8000
+    assert validation.check_memory("runs = 3", 1000, copies=2.5) == 20000
+    limit_numbers = validation.MEMORY_LIMIT_BYTES // validation.FLOAT_BYTES
+    assert validation.check_memory("n", limit_numbers) == validation.MEMORY_LIMIT_BYTES
+    with pytest.raises(ValueError, match=r"^runs = 10000000 would need about 2 GiB for the "
+                                         r"estimates, more than the limit of 2 GiB "
+                                         r"\(validation.MEMORY_LIMIT_BYTES\); use fewer runs"):
+        validation.check_memory("runs = 10000000", limit_numbers + 1, what="for the estimates")
+    # Python ints: a size no machine could hold is estimated, not overflowed.
+    with pytest.raises(ValueError, match=r"would need about 7.45e\+1[0-9] GiB"):
+        validation.check_memory("n_steps = 10**20", validation.elements((10**20, 10)))
+
+
+def test_a_covariance_of_subnormal_numbers_counts_as_zero() -> None:
+    # Found by hypothesis: Q for a jerk of 1e-158 cm/s³ has entries near 1e-328, whose
+    # rounding made the scaled matrix look indefinite.
+    from lqe_helpers import model
+
+    Q = model.process_noise_covariance(0.01, 1.1344280960175625e-158)
+    assert np.max(np.abs(Q)) < np.finfo(float).tiny
+    np.testing.assert_array_equal(validation.covariance("Q", Q, size=3), Q)
