@@ -88,5 +88,5 @@ def assert_only_numbers_change(explorer, name: str, value: float) -> None:
     explorer.sliders[name].value = value
     assert texts() == before
     assert explorer.numbers != numbers
-    repainted = explorer.layers._background.redrawn
+    repainted = explorer.layers.repainted
     assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]

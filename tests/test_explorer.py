@@ -22,15 +22,10 @@ from matplotlib.lines import Line2D
 from matplotlib.text import Text
 from PIL import Image
 
-from lqe_helpers.explorer import (
-    Explorer,
-    encode_png,
-    float_slider,
-    log_slider,
-    pin_axis_labels,
-    reuse_panels,
-)
-from lqe_helpers.explorers._layers import LayeredCanvas
+from lqe_helpers.explorers import Explorer, float_slider, log_slider
+from lqe_helpers.explorers.layers import LayeredCanvas
+from lqe_helpers.explorers.panels import pin_axis_labels, reuse_panels
+from lqe_helpers.explorers.png import encode_picture
 from lqe_helpers.scenario import DEFAULT
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
@@ -486,7 +481,7 @@ def test_a_marker_is_repainted_with_what_covers_it_only_where_it_is():
         reference.canvas.draw()
         np.testing.assert_array_equal(pixels, np.asarray(reference.canvas.buffer_rgba()))
     assert layers.fast_renders >= 3, (layers.full_renders, layers.fast_renders)
-    assert legend not in layers._background.redrawn  # far from the marker: not repainted
+    assert legend not in layers.repainted  # far from the marker: not repainted
 
 
 def test_png_encoding_keeps_every_pixel():
@@ -495,7 +490,7 @@ def test_png_encoding_keeps_every_pixel():
     opaque[..., 3] = 255
     translucent = rng.integers(0, 256, (7, 5, 4), dtype=np.uint8)
     for rgba in (opaque, translucent):
-        decoded = np.asarray(Image.open(io.BytesIO(encode_png(rgba, 90))).convert("RGBA"))
+        decoded = np.asarray(Image.open(io.BytesIO(encode_picture(rgba, 90))).convert("RGBA"))
         np.testing.assert_array_equal(decoded, rgba)
 
 

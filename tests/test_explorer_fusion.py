@@ -190,7 +190,7 @@ def test_the_right_panels_title_stays_in_the_cached_background():
         explorer.sliders["sigma_v"].value = sigma_v
         explorer.sliders["sigma_p"].value = sigma_p
     assert explorer.layers.fast_renders >= 1
-    repainted = explorer.layers._background.redrawn  # the artists a move repaints
+    repainted = explorer.layers.repainted  # the artists a move repaints
     assert any(patch.get_gid() == "weight vision" for patch in repainted)
     assert title not in repainted
 

@@ -26,11 +26,13 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
 from .. import experiments, model, validation
-from ..explorer import Explorer, log_slider, reuse_panels, starting_value
 from ..plotting import COLORS, label_time_position, style
 from ..prediction import OpenLoop, amplitude_crossing, open_loop
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
+from .base import Explorer
+from .panels import reuse_panels
+from .sliders import log_slider, starting_value
 
 #: Seconds of open-loop prediction drawn in the left panel.
 OPEN_LOOP_DURATION = 1.0

@@ -32,17 +32,12 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model, simulation, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    log_slider,
-    reuse_panels,
-    starting_value,
-)
 from ..filter import FilterResult, kalman_filter
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer
+from .panels import DATA_UNDER_LINES, reuse_panels
+from .sliders import float_slider, log_slider, starting_value
 
 #: Slider range of the true bias b (cm/s²): up to 60 % of the path's peak acceleration.
 BIAS_RANGE = (-60.0, 60.0)

@@ -22,9 +22,11 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from .. import experiments
-from ..explorer import DATA_UNDER_LINES, Explorer, float_slider, reuse_panels, starting_value
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer
+from .panels import DATA_UNDER_LINES, reuse_panels
+from .sliders import float_slider, starting_value
 
 #: Longest delay the slider offers (s): a quarter of the butterfly's period, far past
 #: the point where prediction stops paying off.

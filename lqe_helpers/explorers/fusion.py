@@ -22,17 +22,10 @@ from matplotlib.text import Annotation
 
 from .. import experiments, validation
 from ..cue_combination import reliability_weights
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    pin_axis_labels,
-    reuse_panels,
-    starting_value,
-)
 from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
-from ._trial import (
+from .base import Explorer
+from .common import (
     TrialLine,
     TrialPanels,
     build_trial_panels,
@@ -40,6 +33,8 @@ from ._trial import (
     legend_handles,
     trial_numbers,
 )
+from .panels import DATA_UNDER_LINES, pin_axis_labels, reuse_panels
+from .sliders import float_slider, starting_value
 
 #: The fused filter's sensors, in the column order of its noise and gains.
 FUSED = ("vision", "proprioception")
@@ -47,7 +42,7 @@ FUSED = ("vision", "proprioception")
 #: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_RANGE = (0.5, 6.0, 0.25)
 
-#: Plotted lines by gid (see :data:`~._trial.TrialLine`).
+#: Plotted lines by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "vision readings": (0, "vision", "vision readings"),
     "proprioception readings": (0, "proprioception", "proprioception readings"),

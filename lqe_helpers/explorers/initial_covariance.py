@@ -27,16 +27,11 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    log_slider,
-    reuse_panels,
-    set_ylim_in_steps,
-    starting_value,
-)
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer
+from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .sliders import log_slider, starting_value
 
 #: Slider range for P0 (cm², same number for cm²/s² and cm²/s⁴): from "certain of
 #: the initial guess" to "no idea at all".

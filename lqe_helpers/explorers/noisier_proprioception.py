@@ -21,11 +21,11 @@ from matplotlib.ticker import NullLocator
 
 from .. import experiments, model, validation
 from ..cue_combination import reliability_weights
-from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from ..steady_state import steady_state
-from ._trial import (
+from .base import Explorer
+from .common import (
     TrialLine,
     TrialPanels,
     build_trial_panels,
@@ -34,6 +34,8 @@ from ._trial import (
     trial_numbers,
 )
 from .fusion import FUSED, unit_noise, vision_only
+from .panels import pin_axis_labels, reuse_panels
+from .sliders import float_slider
 
 #: σ_p (cm) of question (d), where the slider starts.
 QUESTION_SIGMA_P = 4.5
@@ -47,7 +49,7 @@ CURVE_RANGE = (0.3, 100.0)
 #: Title of the right panel; it never changes, so it stays in the cached background.
 THEORY_TITLE = "steady state"
 
-#: Plotted lines of the left column by gid (see :data:`~._trial.TrialLine`).
+#: Plotted lines of the left column by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "truth": (0, "truth", "true position"),
     "vision-only": (0, "alternative", "vision-only estimate"),

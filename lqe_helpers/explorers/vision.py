@@ -8,7 +8,7 @@ between the slider and the figure.
 
 Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
 filter run, so :func:`draw_vision` builds the panel once per figure
-(:func:`~lqe_helpers.explorer.reuse_panels`) and afterwards only replaces the data
+(:func:`~lqe_helpers.explorers.panels.reuse_panels`) and afterwards only replaces the data
 and limits of the same artists; the numbers stay out of the figure, where text would
 be rendered again on every move. The picture is the same as a fresh drawing (a test
 checks the PNG bytes); only the redraw is faster.
@@ -26,16 +26,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    reuse_panels,
-    set_ylim_in_steps,
-    starting_value,
-)
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer
+from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .sliders import float_slider, starting_value
 
 #: Slider range for σ_v (cm): from a nearly perfect eye to noise as large as the flight.
 SIGMA_V_RANGE = (0.1, 10.0)
