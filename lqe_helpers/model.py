@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import validation
+from . import _matrices, validation
 
 #: Sensors that can observe the butterfly, in the row order of ``C`` and ``R``.
 SENSORS = ("vision", "proprioception")
@@ -96,7 +96,7 @@ def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
     ndarray, shape (m, 3)
         One row ``[1, 0, 0]`` per sensor.
     """
-    return np.tile([1.0, 0.0, 0.0], (len(sensor_names(sensors)), 1))
+    return _matrices.observation(len(sensor_names(sensors)))
 
 
 def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -115,9 +115,7 @@ def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.nda
     sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
     if np.any(sigmas <= 0):
         raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
-    variances = sigmas**2
-    eye = np.eye(sigmas.shape[-1])
-    return variances[..., :, None] * eye
+    return _matrices.noise_covariance(sigmas)
 
 
 def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarray:
@@ -141,7 +139,7 @@ def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarr
             f"variance must be > 0, got {np.ravel(variance)[:6].tolist()}"
         )
     size = validation.count("size", size, minimum=1)
-    return variance[..., None, None] * np.eye(size)
+    return _matrices.scaled_identity(variance, size)
 
 
 def sensor_names(sensors: Sequence[str]) -> tuple[str, ...]:
