@@ -21,6 +21,7 @@ rendering), then writes the PNG without row filters (:mod:`lqe_helpers.explorers
 from __future__ import annotations
 
 import base64
+import dataclasses
 import html
 from collections.abc import Callable, Mapping
 
@@ -28,12 +29,25 @@ import ipywidgets as widgets
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+from ..scenario import Scenario
+from ..student_code import StudentCodeError
 from . import png
 from .layers import LayeredCanvas
 
 #: Signature of a drawing function: it (re)draws ``figure`` for the slider values and
 #: returns the numbers of this view as one line of plain text (or None).
 DrawFunction = Callable[..., "str | None"]
+
+
+def with_explorer_seed(scenario: Scenario) -> Scenario:
+    """``scenario`` with its seed replaced by its ``explorer_seed``: where explorers draw noise.
+
+    An explorer shows another noise draw than the tasks compute on, so at its default
+    values it never prints a number a task asks the student to find (issue 15). Every
+    explorer draws its fixed unit noise from this scenario, and only its noise: all
+    else comes from the scenario it was given.
+    """
+    return dataclasses.replace(scenario, seed=scenario.explorer_seed)
 
 
 class Explorer:
@@ -50,7 +64,11 @@ class Explorer:
         if it needs to) and returns the numbers of this view (this run's MSEs, a gain,
         …) as one line of plain text, or None; must not call pyplot. The line is shown
         between the sliders and the figure (:attr:`numbers`), not drawn in the figure:
-        text is the costliest thing to render again on every move.
+        text is the costliest thing to render again on every move. It may raise
+        :class:`~lqe_helpers.student_code.StudentCodeError` when a student's function it
+        runs fails: the explorer then shows that message in the numbers line
+        (:attr:`problem`) and keeps its last picture, and the next move tries again.
+        Any other exception propagates: it is a bug of the pack.
     figsize : (float, float)
         Figure size in inches; with ``dpi`` it fixes the image's height on the page.
     dpi : int
@@ -75,8 +93,12 @@ class Explorer:
         FigureCanvasAgg(self.figure)
         self.layers = LayeredCanvas(self.figure)
         width, height = (round(size * dpi) for size in figsize)
-        #: The numbers of the current view, as ``draw`` returned them ("" for none).
+        #: The numbers of the current view, as ``draw`` returned them ("" for none),
+        #: or the one-line :attr:`problem` when the last drawing failed.
         self.numbers = ""
+        #: The student's code's one-line message if the last drawing raised a
+        #: StudentCodeError, else "".
+        self.problem = ""
         self.readout = widgets.HTML(layout=widgets.Layout(margin="0 0 0 8px"))
         self.image = widgets.Image(
             format="png",
@@ -118,13 +140,32 @@ class Explorer:
         of the rest (:class:`~lqe_helpers.explorers.layers.LayeredCanvas`); the
         picture is the same as a full rendering.
         """
-        numbers = self.draw(self.figure, **self.values)
+        try:
+            numbers = self.draw(self.figure, **self.values)
+        except StudentCodeError as error:
+            self._show_problem(error)
+            return
         if numbers is not None and not isinstance(numbers, str):
             raise TypeError(f"draw must return a str or None, got {type(numbers).__name__}")
         self.png = png.encode_picture(self.layers.render(), self.dpi)
+        self.problem = ""
         self.numbers = numbers or ""
         self.readout.value = html.escape(self.numbers)
         self.image.value = self.png
+
+    def _show_problem(self, error: StudentCodeError) -> None:
+        """Show ``error`` as one line in place of the numbers; keep the last picture.
+
+        Never a traceback: the slider stays usable and its next move draws again. An
+        explorer whose very first drawing fails shows its figure as it is (no picture
+        was made before).
+        """
+        self.problem = " ".join(str(error).split()) or "the student's function failed"
+        self.numbers = self.problem
+        self.readout.value = html.escape(self.problem)
+        if not self.png:
+            self.png = png.encode_picture(self.layers.render(), self.dpi)
+            self.image.value = self.png
 
     def _on_change(self, change: Mapping[str, object]) -> None:
         self.redraw()
