@@ -1,10 +1,13 @@
-"""The sensor side of the filter's model, from inputs already checked (internal to lqe_helpers).
+"""Matrices of a filter's model from inputs already checked (internal to lqe_helpers).
 
-The formulas behind :func:`lqe_helpers.model.observation_matrix` (Tutorial eq. (3)),
+The formulas behind :func:`lqe_helpers.model.process_noise_covariance` and
+:func:`lqe_helpers.bias_model.process_noise_covariance` (Lesson 0.5 eq. (9)),
+:func:`lqe_helpers.model.observation_matrix` (Tutorial eq. (3)),
 :func:`lqe_helpers.model.measurement_noise_covariance` (Tutorial eq. (6)) and
 :func:`lqe_helpers.model.diagonal_covariance`. Those public functions check their
 inputs and call these; so do the one builder of the filter's model
-(:func:`lqe_helpers.experiments.filter_model`) and ``experiments.track`` after checking
+(:func:`lqe_helpers.experiments.filter_model`, ``bias_model.filter_model``) and the
+runs (``experiments.track``, ``bias_model.unbiased_run``) after checking
 their own inputs, so that a value (σ_v from a slider, say) is checked once on its way
 to the filter, at the public entry it came through. Nothing here checks anything: call
 these only with values a public entry has checked.
@@ -13,6 +16,15 @@ these only with values a public entry has checked.
 from __future__ import annotations
 
 import numpy as np
+
+
+def input_noise_covariance(g: np.ndarray, sigma: float) -> np.ndarray:
+    """``G σ² Gᵀ``: what an input's noise of σ adds each step (Lesson 0.5 eq. (9)), (k, k).
+
+    ``g`` (k, 1) is the input matrix, ``sigma`` the input's standard deviation (>= 0),
+    both already checked.
+    """
+    return sigma**2 * (g @ g.T)
 
 
 def observation(n_sensors: int) -> np.ndarray:

@@ -78,8 +78,7 @@ def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
         Q with units cm², cm²/s, cm²/s², ... (row i, column j: cm²/s^(i+j)).
     """
     jerk_std = validation.non_negative("jerk_std", jerk_std, "cm/s³")
-    g = jerk_input_matrix(dt)
-    return jerk_std**2 * (g @ g.T)
+    return _matrices.input_noise_covariance(jerk_input_matrix(dt), jerk_std)
 
 
 def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
