@@ -43,6 +43,8 @@ FUSED = ("vision", "proprioception")
 
 #: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_RANGE = (0.5, 6.0, 0.25)
+#: How many vision-only runs (one per σ_v, about 0.2 MB each) the explorer keeps.
+VISION_RUNS_KEPT = 16
 
 #: Plotted lines by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
@@ -221,9 +223,9 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
 
     The unit noise is drawn once from the scenario's explorer seed (another draw than
     the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so a
-    slider changes only how loud a sense is, never its noise pattern; moving σ_p reuses
-    the vision-only run. The sliders start at the scenario's σ_v and σ_p (question (c):
-    1.5 cm each).
+    slider changes only how loud a sense is, never its noise pattern; moving σ_p (or σ_v
+    back to a recent value) reuses a kept vision-only run. The sliders start at the
+    scenario's σ_v and σ_p (question (c): 1.5 cm each).
 
     Raises
     ------
@@ -239,7 +241,9 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
         "sigma_p": float_slider("σ_p (cm)", start_p, low, high, step),
     }
     noise = unit_noise(with_explorer_seed(scenario))
-    draw = partial(_draw, scenario=scenario, noise=noise,
-                   vision_runs=LastResults(partial(vision_only, scenario, noise=noise)))
+    # The vision-only runs of the last VISION_RUNS_KEPT σ_v: moving σ_p, or σ_v back to a
+    # recent value, reuses one.
+    vision_runs = LastResults(partial(vision_only, scenario, noise=noise), size=VISION_RUNS_KEPT)
+    draw = partial(_draw, scenario=scenario, noise=noise, vision_runs=vision_runs)
     return Explorer("Vision alone against vision + proprioception", sliders, draw,
                     figsize=(10.0, 5.0), describe=describe_fusion)
