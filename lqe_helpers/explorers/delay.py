@@ -215,7 +215,7 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
         "Sensory delay and its compensation: truth, delayed vision, delayed estimate and "
         "prediction",
         {"delay": slider},
-        partial(_draw_on_grid, run=run),
+        partial(_draw, run=run),
         figsize=(9.0, 5.2),
         describe=partial(describe_delay, scenario=scenario),
     )
@@ -230,7 +230,7 @@ def describe_delay(*, delay: float, scenario: Scenario = DEFAULT) -> str:
             f"prediction, with both estimates' errors below.")
 
 
-def _draw_on_grid(figure: Figure, *, delay: float,
+def _draw(figure: Figure, *, delay: float,
                   run: Callable[[], experiments.Tracking]) -> str:
     """Round the slider's float to the nearest whole step, then draw the kept run."""
     tracking = run()
