@@ -1,21 +1,8 @@
 """The biased-input model's equations: its matrices, the hand, the signal, dead reckoning.
 
-The model of :mod:`lqe_helpers.bias_model` (notebook 06, Lesson 0.5); the filter that
-uses it and its results are in :mod:`lqe_helpers.bias_model.tracking`.
-
-State ``z = [p, v, b]``: position (cm), velocity (cm/s) and the bias b (cm/s²) of an
-acceleration signal ``a_r = a + b + noise``. The signal is not measured against the
-state; it drives the prediction as an input, ``z_{j+1} = F z_j + G u_j`` (Lesson 0.5
-eq. (4)), and vision, which reads the position, corrects what the input gets wrong.
-
-In the nervous system the input could be an efference copy of the motor command or
-the otoliths' linear acceleration signal, both of which can carry a slowly varying
-offset; here the moving target is the hand of :data:`~lqe_helpers.scenario.DEFAULT`,
-whose path is the tutorial's sinusoid.
-
-Time convention (that of :func:`~lqe_helpers.filter.kalman_filter`): ``u_j`` is the
-reading over the step that ends at sample j, from ``t_j − Δt`` to ``t_j``, and the
-filter's ``z0`` is the estimate of the state at ``t = −Δt``.
+Part of :mod:`lqe_helpers.bias_model` (notebook 06, Lesson 0.5), whose docstring gives
+the state ``[p, v, b]`` and the time convention; the filter that uses these equations
+and its runs are in :mod:`lqe_helpers.bias_model.tracking`.
 """
 
 from __future__ import annotations
