@@ -145,7 +145,7 @@ def test_the_numbers_go_beside_the_figure_and_its_text_stays_put(explorer) -> No
 def test_a_move_recomputes_only_what_its_slider_changes(explorer) -> None:
     """The filter run hangs on (σ_a, σ_v) only, since a move of b only shifts it; the
     run of the last (σ_a, σ_v) is kept, so a σ moved back to an earlier value pays again."""
-    kept = explorer.draw.keywords["runs"]
+    kept = explorer.draw.keywords["unbiased_runs"]
     noise = bias_model.unit_noise(EXPLORER_SCENARIO)
     start = explorer.sliders["sigma_v"].value
     assert kept.computed == 1

@@ -179,10 +179,10 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
 
 
 def _draw(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
-          runs: Callable[[float, float], bias_model.UnbiasedRun]) -> str:
-    """:func:`draw_bias` for the explorer: ``runs(σ_a, σ_v)`` makes or keeps the filter
+          unbiased_runs: Callable[[float, float], bias_model.UnbiasedRun]) -> str:
+    """:func:`draw_bias` for the explorer: ``unbiased_runs(σ_a, σ_v)`` makes or keeps the filter
     run at b = 0, which a move of b only shifts (``UnbiasedRun.at_bias``)."""
-    return _draw_tracking(figure, runs(sigma_a, sigma_v).at_bias(bias))
+    return _draw_tracking(figure, unbiased_runs(sigma_a, sigma_v).at_bias(bias))
 
 
 def _draw_tracking(figure: Figure, tracking: bias_model.InputTracking) -> str:
@@ -252,7 +252,8 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
     return Explorer(
         "A biased acceleration signal corrected by vision",
         sliders,
-        partial(_draw, runs=LastResults(partial(bias_model.unbiased_run, scenario, noise=noise))),
+        partial(_draw, unbiased_runs=LastResults(partial(bias_model.unbiased_run, scenario,
+                                                         noise=noise))),
         figsize=(10.0, 4.6),
         describe=describe_bias,
     )
