@@ -27,7 +27,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from PIL import Image
 
-from lqe_helpers import png
+from lqe_helpers.explorers import png
 
 #: (notebook, module, factory) of every explorer in the pack.
 EXPLORERS = [
@@ -96,7 +96,7 @@ def compare_encoders() -> None:
     """Median time (ms) of Pillow's PNG encoder and of the pack's on each default picture."""
     print("\nPNG encoding of each explorer's picture (RGB), median of 10: Pillow at "
           f"compress_level={png.COMPRESS_LEVEL} (adaptive row filters) against "
-          "lqe_helpers.png.encode (no row filters)")
+          "lqe_helpers.explorers.png.encode (no row filters)")
     for notebook, module_name, factory in EXPLORERS:
         explorer = getattr(importlib.import_module(module_name), factory)()
         rgb = np.ascontiguousarray(np.asarray(explorer.layers.render())[..., :3])

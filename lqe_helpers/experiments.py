@@ -1,20 +1,91 @@
 """The tutorial's experiments, built from a :class:`~lqe_helpers.scenario.Scenario`.
 
-Notebooks and explorers call these instead of assembling C, R, P0 and noise by
-hand, so a question's setup is written once.
+Notebooks, explorers and checks call these instead of assembling C, R, P0 and noise
+by hand, so a question's setup is written once: :func:`filter_model` is the one
+builder of the model a filter assumes (A, C, Q, R, z0, P0), :func:`track` simulates
+the sensors and runs that filter, :func:`delay_and_compensate` delays its output.
+Their results draw their own standard figures (:meth:`Tracking.figure`,
+:meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only
+when a figure is asked for).
+
+Each public function checks its inputs once, at its entry; what it calls inside
+(:mod:`lqe_helpers._matrices`) checks nothing again.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import metrics, model, simulation, validation
+from . import _matrices, metrics, model, simulation, validation
 from .filter import FilterResult, kalman_filter
 from .prediction import predict_ahead
 from .scenario import Scenario
+from .steady_state import SteadyState, steady_state
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+#: Roles of the estimates :meth:`Tracking.figure` compares with its own, in order.
+COMPARISON_ROLES = ("alternative", "reference")
+
+
+@dataclass(frozen=True)
+class FilterModel:
+    """The model a filter assumes: what :func:`~lqe_helpers.filter.kalman_filter` takes.
+
+    Built by :func:`filter_model` (the butterfly, Tutorial eqs. (1)–(6)) or
+    :func:`lqe_helpers.bias_model.filter_model` (a known input, Lesson 0.5 eqs. (4)–(9)).
+    Its arrays are read-only: one model may serve many runs.
+
+    Attributes
+    ----------
+    A : ndarray, shape (k, k)
+        Transition matrix.
+    C : ndarray, shape (m, k)
+        Observation matrix.
+    Q : ndarray, shape (k, k)
+        Process noise covariance.
+    R : ndarray, shape (..., m, m)
+        Sensor noise covariance (cm²); leading axes sweep σ.
+    z0 : ndarray, shape (k,)
+        Initial estimate.
+    P0 : ndarray, shape (..., k, k)
+        Initial covariance; leading axes sweep P0.
+    B : ndarray, shape (k, p), or None
+        Input matrix, for a filter driven by a known input.
+    """
+
+    A: np.ndarray
+    C: np.ndarray
+    Q: np.ndarray
+    R: np.ndarray
+    z0: np.ndarray
+    P0: np.ndarray
+    B: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        for field in fields(self):
+            value = getattr(self, field.name)
+            if value is not None:
+                array = np.array(value, dtype=float)
+                array.flags.writeable = False
+                object.__setattr__(self, field.name, array)
+
+    def filter(self, y: np.ndarray, u: np.ndarray | None = None) -> FilterResult:
+        """:func:`~lqe_helpers.filter.kalman_filter` of ``y`` (..., n, m) with this model.
+
+        ``u`` (..., n, p) is the known input, for a model with ``B``.
+        """
+        return kalman_filter(y, self.A, self.C, self.Q, self.R, self.z0, self.P0,
+                             B=self.B, u=u)
+
+    def steady_state(self) -> SteadyState:
+        """The filter's steady state (:func:`~lqe_helpers.steady_state.steady_state`)."""
+        return steady_state(self.A, self.C, self.Q, self.R)
 
 
 @dataclass(frozen=True)
@@ -30,12 +101,15 @@ class Tracking:
         Noisy readings (cm); leading axes are Monte Carlo runs, then any sweep axes.
     result : FilterResult
         The filter's estimates, gains and covariances, same leading axes.
+    model : FilterModel
+        The model the filter assumed (its R from the assumed σ).
     """
 
     scenario: Scenario
     sensors: tuple[str, ...]
     measurements: np.ndarray
     result: FilterResult
+    model: FilterModel
 
     @property
     def positions(self) -> np.ndarray:
@@ -62,6 +136,145 @@ class Tracking:
         column = self.sensors.index(sensor)
         return metrics.mse(self.measurements[..., column], self.scenario.truth[:, 0],
                            self.scenario.burn_in_steps)
+
+    def figure(self, label: str = "filtered estimate", *,
+               against: Mapping[str, Tracking] | None = None, readings: bool = True,
+               title: str = "", run: int | tuple[int, ...] | None = None) -> Figure:
+        """This run's estimate beside the truth, its error below: the standard figure.
+
+        Built by :func:`lqe_helpers.figures.tracking_comparison_figure`, so a notebook
+        passes one object instead of six arrays.
+
+        Parameters
+        ----------
+        label : str
+            Legend label of this tracking's estimate (drawn blue, the estimate's role).
+        against : mapping of str to Tracking, optional
+            Other filters' runs of the same scenario to compare, by legend label (at
+            most two; drawn in the roles of :data:`COMPARISON_ROLES`, before this one).
+        readings : bool
+            Whether to draw this run's sensor readings ("vision readings", …).
+        title : str
+            Title of the top panel (say what changed, e.g. "σ_v = 1.5 cm").
+        run : int or tuple of int, optional
+            Which run of a batch (an index into the leading axes, the same in every
+            tracking); required when there are leading axes.
+
+        Returns
+        -------
+        matplotlib.figure.Figure
+
+        Raises
+        ------
+        ValueError
+            If ``run`` does not pick one run, or ``against`` holds anything but at most
+            two trackings of this scenario.
+        """
+        from . import figures
+
+        against = dict(against or {})
+        if len(against) > len(COMPARISON_ROLES) or not all(
+                isinstance(other, Tracking) and other.scenario == self.scenario
+                for other in against.values()):
+            raise ValueError(
+                f"against must map labels to at most {len(COMPARISON_ROLES)} Trackings of "
+                f"this scenario, got {[type(other).__name__ for other in against.values()]}")
+        estimates = {name: (_one_run(other.positions, run), role)
+                     for (name, other), role in zip(against.items(),
+                                                     COMPARISON_ROLES[:len(against)],
+                                                     strict=True)}
+        estimates[label] = (_one_run(self.positions, run), "estimate")
+        shown = None
+        if readings:
+            measured = _one_run(self.measurements, run, trailing=2)
+            shown = {f"{sensor} readings": (measured[:, column], sensor)
+                     for column, sensor in enumerate(self.sensors)}
+        return figures.tracking_comparison_figure(self.scenario.times, self.scenario.truth[:, 0],
+                                                  estimates, readings=shown, title=title)
+
+
+def _one_run(values: np.ndarray, run: int | tuple[int, ...] | None,
+             trailing: int = 1) -> np.ndarray:
+    """``values[run]``, which must leave ``trailing`` axes (one run of a batch)."""
+    index = () if run is None else np.index_exp[run]
+    try:
+        one = values[index]
+    except (IndexError, TypeError):
+        one = None
+    if one is None or one.ndim != trailing:
+        raise ValueError(
+            f"run must pick one run of the leading axes {values.shape[:-trailing]}, got {run!r}")
+    return one
+
+
+def _sensor_sigmas(name: str, sigmas: object, sensors: tuple[str, ...]) -> np.ndarray:
+    """``sigmas`` (cm) as an array of shape (..., m): finite, > 0, one σ per sensor."""
+    sigmas = validation.positive_array(name, sigmas, "cm", min_ndim=1)
+    if sigmas.shape[-1] != len(sensors):
+        raise ValueError(
+            f"{name} must have one σ per sensor {sensors} on its last axis, "
+            f"got shape {sigmas.shape}"
+        )
+    return sigmas
+
+
+def _assemble(scenario: Scenario, sensors: tuple[str, ...], sigmas: np.ndarray,
+              p0_variance: np.ndarray) -> FilterModel:
+    """The model of :func:`filter_model` from inputs its caller has checked."""
+    return FilterModel(
+        A=scenario.A, C=_matrices.observation(len(sensors)), Q=scenario.Q,
+        R=_matrices.noise_covariance(sigmas), z0=np.asarray(scenario.z0, dtype=float),
+        P0=_matrices.scaled_identity(p0_variance, 3),
+    )
+
+
+def filter_model(scenario: Scenario, sensors: Sequence[str] = ("vision",),
+                 sigmas: Sequence[float] | np.ndarray | None = None,
+                 p0_variance: float | np.ndarray | None = None) -> FilterModel:
+    """The model a filter of the butterfly assumes (Tutorial eqs. (1)–(6)): the one builder.
+
+    ``A`` and ``Q`` of the scenario's Δt and σ_j, ``C`` with one row ``[1, 0, 0]`` per
+    sensor (eq. (3)), ``R = diag(σ²)`` (eq. (6)), ``z0`` of the scenario and
+    ``P0 = p0_variance · I``. :func:`track` runs the filter with this model; its
+    :meth:`~FilterModel.steady_state` gives the theory the notebooks compare with.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies Δt, Q, z0 and the defaults.
+    sensors : sequence of str
+        ``("vision",)`` or ``("vision", "proprioception")``.
+    sigmas : array_like, shape (..., m), optional
+        The σ the filter assumes for each sensor (cm), > 0; default the scenario's σ_v
+        and σ_p. Leading axes sweep σ (a stack of R).
+    p0_variance : float or array_like, shape (...), optional
+        P0 = p0_variance · I (cm², cm²/s², cm²/s⁴), > 0; default the scenario's. An
+        array sweeps P0 (a stack of P0), broadcasting against the sweep of σ.
+
+    Returns
+    -------
+    FilterModel
+
+    Raises
+    ------
+    ValueError
+        If an input is of the wrong kind, shape or range.
+    """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    sensors = model.sensor_names(sensors)
+    if sigmas is None:
+        sigmas = _default_sigmas(scenario, sensors)
+    sigmas = _sensor_sigmas("sigmas", sigmas, sensors)
+    p0 = validation.positive_array(
+        "p0_variance", scenario.p0_variance if p0_variance is None else p0_variance, "cm²")
+    validation.broadcast_batches(sigmas=sigmas.shape[:-1], p0_variance=p0.shape)
+    return _assemble(scenario, sensors, sigmas, p0)
+
+
+def _default_sigmas(scenario: Scenario, sensors: tuple[str, ...]) -> list[float]:
+    """The scenario's σ of each sensor (cm)."""
+    defaults = {"vision": scenario.sigma_v, "proprioception": scenario.sigma_p}
+    return [defaults[sensor] for sensor in sensors]
 
 
 def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
@@ -95,23 +308,16 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
     -------
     Tracking
         Leading axes: runs (if any), then the sweep axes of sigmas, assumed_sigmas and
-        p0_variance broadcast together.
+        p0_variance broadcast together. Its ``model`` is :func:`filter_model` of the
+        assumed σ and P0.
     """
     validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
     sensors = model.sensor_names(sensors)
-    C = model.observation_matrix(sensors)
-    defaults = {"vision": scenario.sigma_v, "proprioception": scenario.sigma_p}
     if sigmas is None:
-        sigmas = [defaults[s] for s in sensors]
-    sigmas = validation.positive_array("sigmas", sigmas, "cm", min_ndim=1)
-    assumed = sigmas if assumed_sigmas is None else validation.positive_array(
-        "assumed_sigmas", assumed_sigmas, "cm", min_ndim=1)
-    for name, value in (("sigmas", sigmas), ("assumed_sigmas", assumed)):
-        if value.shape[-1] != len(sensors):
-            raise ValueError(
-                f"{name} must have one σ per sensor {sensors} on its last axis, "
-                f"got shape {value.shape}"
-            )
+        sigmas = _default_sigmas(scenario, sensors)
+    sigmas = _sensor_sigmas("sigmas", sigmas, sensors)
+    assumed = sigmas if assumed_sigmas is None else _sensor_sigmas(
+        "assumed_sigmas", assumed_sigmas, sensors)
     p0 = validation.positive_array(
         "p0_variance", scenario.p0_variance if p0_variance is None else p0_variance, "cm²")
     sweep = validation.broadcast_batches(
@@ -124,11 +330,8 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
     noise = validation.shaped_array("noise", noise, expected, ", ".join(sensors))
     noise = noise.reshape(noise.shape[:-2] + (1,) * len(sweep) + noise.shape[-2:])
     y = simulation.measure(scenario.truth[:, 0], noise, sigmas)
-    result = kalman_filter(
-        y, scenario.A, C, scenario.Q, model.measurement_noise_covariance(assumed),
-        np.asarray(scenario.z0, float), model.diagonal_covariance(p0),
-    )
-    return Tracking(scenario, sensors, y, result)
+    filter_ = _assemble(scenario, sensors, assumed, p0)
+    return Tracking(scenario, sensors, y, filter_.filter(y), filter_)
 
 
 @dataclass(frozen=True)
@@ -157,6 +360,41 @@ class DelayedTracking:
     delayed_measurements: np.ndarray
     delayed_estimates: np.ndarray
     predictions: np.ndarray
+
+    @property
+    def delay(self) -> float:
+        """The delay d = δ Δt (s)."""
+        return self.steps * self.tracking.scenario.dt
+
+    def figure(self, fast_window: tuple[float, float] = (3.75, 4.35), *,
+               run: int | tuple[int, ...] | None = None) -> Figure:
+        """Question (e)'s standard figure: truth, late readings, late and compensated estimate.
+
+        Built by :func:`lqe_helpers.figures.delay_figure` (the whole trial, the start
+        with nothing arrived yet shaded, and ``fast_window`` (s) of fast flight), so a
+        notebook writes ``delayed.figure()`` instead of passing six arrays.
+
+        Parameters
+        ----------
+        fast_window : tuple of float
+            (start, end) of the bottom-right zoom (s).
+        run : int or tuple of int, optional
+            Which run of a batch (an index into the leading axes); required when there
+            are leading axes.
+
+        Raises
+        ------
+        ValueError
+            If ``run`` does not pick one run, or the delay is 0 (nothing to show).
+        """
+        from . import figures
+
+        scenario = self.tracking.scenario
+        return figures.delay_figure(
+            scenario.times, scenario.truth[:, 0],
+            _one_run(self.delayed_measurements, run, trailing=2)[:, 0],
+            _one_run(self.delayed_estimates, run, trailing=2)[:, 0],
+            _one_run(self.predictions, run, trailing=2)[:, 0], self.delay, fast_window)
 
     def mse(self, which: str) -> np.ndarray:
         """Per-run position MSE (cm²) of ``"delayed"`` or ``"predicted"`` estimates.

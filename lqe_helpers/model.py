@@ -9,7 +9,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from . import validation
+from . import _matrices, validation
 
 #: Sensors that can observe the butterfly, in the row order of ``C`` and ``R``.
 SENSORS = ("vision", "proprioception")
@@ -80,9 +80,8 @@ def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
     """
     jerk_std = validation.non_negative("jerk_std", jerk_std, "cm/s³")
     dt = validation.positive("dt", dt, "s")
-    g = jerk_input_matrix(dt)
     return _in_range(f"jerk_std = {jerk_std:g} cm/s³ with dt = {dt:g} s",
-                     lambda: jerk_std**2 * (g @ g.T))
+                     lambda: _matrices.input_noise_covariance(jerk_input_matrix(dt), jerk_std))
 
 
 def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
@@ -99,7 +98,7 @@ def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
     ndarray, shape (m, 3)
         One row ``[1, 0, 0]`` per sensor.
     """
-    return np.tile([1.0, 0.0, 0.0], (len(sensor_names(sensors)), 1))
+    return _matrices.observation(len(sensor_names(sensors)))
 
 
 def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.ndarray:
@@ -118,10 +117,9 @@ def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.nda
     sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
     if np.any(sigmas <= 0):
         raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
-    variances = _in_range(f"sigmas (largest {np.max(sigmas):g} cm, smallest "
-                          f"{np.min(sigmas):g} cm)", lambda: sigmas**2, positive=True)
-    eye = np.eye(sigmas.shape[-1])
-    return variances[..., :, None] * eye
+    _in_range(f"sigmas (largest {np.max(sigmas):g} cm, smallest {np.min(sigmas):g} cm)",
+              lambda: sigmas**2, positive=True)
+    return _matrices.noise_covariance(sigmas)
 
 
 def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarray:
@@ -147,7 +145,7 @@ def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarr
     size = validation.count("size", size, minimum=1)
     validation.check_memory(f"size = {size} with variance of shape {variance.shape}",
                             (variance.size + 1) * size * size, what="for the covariances")
-    return variance[..., None, None] * np.eye(size)
+    return _matrices.scaled_identity(variance, size)
 
 
 def _in_range(inputs: str, compute, positive: bool = False) -> np.ndarray:

@@ -6,6 +6,7 @@ Imported by the ``tests/test_explorer*.py`` files as ``explorer_checks`` (pytest
 
 from __future__ import annotations
 
+import dataclasses
 import io
 
 import numpy as np
@@ -16,7 +17,16 @@ from matplotlib.figure import Figure
 from matplotlib.legend import Legend
 from matplotlib.text import Text
 
-from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.scenario import DEFAULT, Scenario
+
+
+def explorer_draw(scenario: Scenario = DEFAULT) -> Scenario:
+    """``scenario`` with the seed explorers draw their noise from (its ``explorer_seed``)."""
+    return dataclasses.replace(scenario, seed=scenario.explorer_seed)
+
+
+#: The scenario whose noise the explorers show by default: another draw than the tasks'.
+EXPLORER_SCENARIO = explorer_draw(DEFAULT)
 
 
 def line(ax: Axes, label: str) -> np.ndarray:
@@ -88,5 +98,5 @@ def assert_only_numbers_change(explorer, name: str, value: float) -> None:
     explorer.sliders[name].value = value
     assert texts() == before
     assert explorer.numbers != numbers
-    repainted = explorer.layers._background.redrawn
+    repainted = explorer.layers.repainted
     assert not [artist for artist in repainted if isinstance(artist, (Text, Legend))]

@@ -131,22 +131,85 @@ def test_filter_model_is_the_one_track_with_input_uses() -> None:
     scenario = dataclasses.replace(DEFAULT, amplitude=4.0, frequency=1.5)
     model = bias_model.filter_model(scenario, sigma_a=30.0, sigma_v=2.5, bias_prior_std=40.0)
     dt = scenario.dt
-    np.testing.assert_array_equal(model["A"], [[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
-    np.testing.assert_array_equal(model["B"], [[dt**2 / 2], [dt], [0]])
-    np.testing.assert_allclose(model["Q"], 900.0 * model["B"] @ model["B"].T, rtol=1e-15)
-    np.testing.assert_array_equal(model["C"], [[1.0, 0.0, 0.0]])
-    np.testing.assert_array_equal(model["R"], [[6.25]])
-    np.testing.assert_array_equal(model["z0"], np.zeros(3))
-    np.testing.assert_allclose(model["P0"], np.diag([16.0, (4.0 * 2 * np.pi * 1.5) ** 2, 1600.0]),
+    np.testing.assert_array_equal(model.A, [[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
+    np.testing.assert_array_equal(model.B, [[dt**2 / 2], [dt], [0]])
+    np.testing.assert_allclose(model.Q, 900.0 * model.B @ model.B.T, rtol=1e-15)
+    np.testing.assert_array_equal(model.C, [[1.0, 0.0, 0.0]])
+    np.testing.assert_array_equal(model.R, [[6.25]])
+    np.testing.assert_array_equal(model.z0, np.zeros(3))
+    np.testing.assert_allclose(model.P0, np.diag([16.0, (4.0 * 2 * np.pi * 1.5) ** 2, 1600.0]),
                                rtol=1e-15)
+    assert not model.P0.flags.writeable
     tracking = bias_model.track_with_input(scenario, bias=5.0, sigma_a=30.0, sigma_v=2.5,
                                            bias_prior_std=40.0)
-    direct = kalman_filter(tracking.measurements, **model, u=tracking.readings[:, None])
-    np.testing.assert_array_equal(tracking.result.estimates, direct.estimates)
+    direct = kalman_filter(tracking.measurements, model.A, model.C, model.Q, model.R, model.z0,
+                           model.P0, B=model.B, u=tracking.readings[:, None])
+    np.testing.assert_allclose(tracking.result.estimates, direct.estimates, rtol=1e-9,
+                               atol=1e-9)
+    np.testing.assert_array_equal(tracking.result.estimate_covariances,
+                                  direct.estimate_covariances)
     for name, value in (("sigma_a", 0.0), ("sigma_v", -1.0), ("bias_prior_std", 0.0)):
         arguments = {"sigma_a": 30.0, "sigma_v": 2.5, "bias_prior_std": 40.0, name: value}
         with pytest.raises(ValueError, match=name):
             bias_model.filter_model(scenario, **arguments)
+
+
+def _biased_filter_by_hand(scenario, bias: float, sigma_a: float, sigma_v: float,
+                           noise: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Estimates of the filter fed the biased signal itself, assembled from the lesson."""
+    dt = scenario.dt
+    readings = bias_model.step_accelerations(scenario) + bias + sigma_a * noise[..., 1]
+    y = scenario.truth[:, :1] + sigma_v * noise[..., :1]
+    F = np.array([[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
+    G = np.array([[dt**2 / 2], [dt], [0]])
+    P0 = np.diag([scenario.amplitude**2, scenario.peak_speed**2, 50.0**2])
+    result = kalman_filter(y, F, np.array([[1.0, 0.0, 0.0]]), sigma_a**2 * G @ G.T,
+                           np.array([[sigma_v**2]]), np.zeros(3), P0, B=G,
+                           u=readings[..., None])
+    return result.estimates, readings
+
+
+def close_to(estimates: np.ndarray, expected: np.ndarray) -> None:
+    """Estimates [p̂, v̂, b̂] agree to 1e-9, relative to each state's largest size."""
+    for column, name in enumerate(("p", "v", "b")):
+        scale = float(np.max(np.abs(expected[..., column])))
+        np.testing.assert_allclose(estimates[..., column], expected[..., column], rtol=1e-9,
+                                   atol=1e-9 * scale, err_msg=name)
+
+
+@pytest.mark.parametrize(("bias", "sigma_a", "sigma_v"),
+                         [(20.0, 20.0, 1.5), (-55.0, 300.0, 4.5), (0.0, 1.0, 0.5),
+                          (60.0, 1000.0, 6.0)])
+def test_unbiased_run_at_a_bias_is_the_filter_fed_that_biased_signal(bias, sigma_a,
+                                                                     sigma_v) -> None:
+    """The linear-in-bias shortcut, against the filter run on the biased signal, to 1e-9."""
+    noise = bias_model.unit_noise(DEFAULT, runs=4)
+    run = bias_model.unbiased_run(DEFAULT, sigma_a, sigma_v, runs=4, noise=noise)
+    shortcut = run.at_bias(bias)
+    estimates, readings = _biased_filter_by_hand(DEFAULT, bias, sigma_a, sigma_v, noise)
+    close_to(shortcut.result.estimates, estimates)
+    np.testing.assert_allclose(shortcut.readings, readings, rtol=1e-12, atol=1e-12)
+    # ... and equal to what notebook 06 calls, run by run.
+    notebook = bias_model.track_with_input(DEFAULT, bias, sigma_a, sigma_v, runs=4, noise=noise)
+    close_to(shortcut.result.estimates, notebook.result.estimates)
+    np.testing.assert_array_equal(shortcut.dead_reckoning, notebook.dead_reckoning)
+    np.testing.assert_array_equal(shortcut.truth, notebook.truth)
+    assert shortcut.result.estimates.shape == (4, DEFAULT.n_steps, 3)
+    assert shortcut.result.gains.shape == (4, DEFAULT.n_steps, 3, 1)
+    single = bias_model.unbiased_run(DEFAULT, sigma_a, sigma_v, noise=noise[0]).at_bias(bias)
+    close_to(single.result.estimates, estimates[0])
+    assert single.result.estimate_covariances.shape == (DEFAULT.n_steps, 3, 3)
+
+
+def test_unit_response_is_the_filter_of_a_constant_unit_input_alone() -> None:
+    run = bias_model.unbiased_run(DEFAULT)
+    model = bias_model.filter_model(DEFAULT, bias_model.DEFAULT_SIGMA_A, DEFAULT.sigma_v)
+    alone = model.filter(np.zeros((DEFAULT.n_steps, 1)), np.ones((DEFAULT.n_steps, 1)))
+    np.testing.assert_allclose(run.unit_response, alone.estimates, rtol=1e-12, atol=1e-12)
+    # Its bias estimate learns the unit step: b̂ → 1 (the bias the filter must remove).
+    assert abs(run.unit_response[-1, 2] - 1.0) < 0.05
+    with pytest.raises(ValueError, match="bias must be a finite number"):
+        run.at_bias(float("inf"))
 
 
 def test_dead_reckoning_spread_matches_monte_carlo_and_power_law() -> None:

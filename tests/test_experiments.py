@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -125,3 +127,164 @@ def test_delay_and_compensate_shifts_and_predicts() -> None:
 def test_bad_input(call, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         call()
+
+
+# --- filter_model: the one builder of the model a filter assumes ---
+
+def _hand_built(dt: float, jerk_std: float, sigmas: list[float], p0: float) -> dict:
+    """Tutorial eqs. (3)-(6) and Lesson 0.5 eq. (9) written out for the butterfly."""
+    g = np.array([[dt**3 / 6], [dt**2 / 2], [dt]])
+    return {
+        "A": np.array([[1.0, dt, dt**2 / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]]),
+        "C": np.array([[1.0, 0.0, 0.0]] * len(sigmas)),
+        "Q": jerk_std**2 * g @ g.T,
+        "R": np.diag(np.square(sigmas)),
+        "z0": np.zeros(3),
+        "P0": p0 * np.eye(3),
+    }
+
+
+@pytest.mark.parametrize(("sensors", "sigmas", "p0"),
+                         [(("vision",), None, None), (FUSED, [1.5, 4.5], 1e5)])
+def test_filter_model_equals_the_matrices_written_out(sensors, sigmas, p0) -> None:
+    built = experiments.filter_model(DEFAULT, sensors, sigmas, p0)
+    expected = _hand_built(DEFAULT.dt, DEFAULT.process_jerk_std,
+                           sigmas or [DEFAULT.sigma_v], p0 or DEFAULT.p0_variance)
+    for name, matrix in expected.items():
+        np.testing.assert_allclose(getattr(built, name), matrix, rtol=1e-12, atol=0,
+                                   err_msg=name)
+    assert built.B is None
+    for name in expected:
+        assert not getattr(built, name).flags.writeable, name
+
+
+def test_filter_model_sweeps_sigma_and_p0_together() -> None:
+    built = experiments.filter_model(DEFAULT, FUSED, [[1.5, 0.5], [1.5, 50.0]],
+                                     np.array([[1.0], [1e5]]))
+    assert built.R.shape == (2, 2, 2) and built.P0.shape == (2, 1, 3, 3)
+    np.testing.assert_array_equal(built.R[1], np.diag([2.25, 2500.0]))
+    with pytest.raises(ValueError, match="sigmas"):
+        experiments.filter_model(DEFAULT, FUSED, [[1.5, 0.5]] * 3, np.ones(2))
+
+
+def test_the_tracking_keeps_the_model_its_filter_assumed() -> None:
+    tracking = experiments.track(DEFAULT, FUSED, sigmas=[1.5, 4.5], assumed_sigmas=[1.5, 1.5],
+                                 p0_variance=10.0)
+    assumed = experiments.filter_model(DEFAULT, FUSED, [1.5, 1.5], 10.0)
+    for name in ("A", "C", "Q", "R", "z0", "P0"):
+        np.testing.assert_array_equal(getattr(tracking.model, name), getattr(assumed, name))
+    rerun = tracking.model.filter(tracking.measurements)
+    np.testing.assert_array_equal(rerun.estimates, tracking.result.estimates)
+
+
+def test_steady_state_of_the_model_is_where_the_filter_settles() -> None:
+    tracking = experiments.track(DEFAULT, FUSED, sigmas=[1.5, 4.5])
+    settled = tracking.model.steady_state()
+    # Independent of the doubling algorithm: 1 000 steps of the filter's own recursion.
+    np.testing.assert_allclose(settled.estimate_covariance,
+                               tracking.result.estimate_covariances[-1], rtol=1e-9)
+    np.testing.assert_allclose(settled.gain, tracking.result.gains[-1], rtol=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [({"scenario": "DEFAULT"}, r"^scenario must be a Scenario"),
+     ({"sensors": "vision"}, r"^sensors must be a non-empty sequence"),
+     ({"sigmas": [1.5, 1.5]}, r"^sigmas must have one σ per sensor \('vision',\)"),
+     ({"sigmas": [0.0]}, r"^sigmas must all be > 0 cm"),
+     ({"sigmas": [True]}, r"^sigmas must be a numeric array, got \[True\]: a boolean"),
+     ({"p0_variance": -1.0}, r"^p0_variance must be > 0 cm², got -1.0")],
+)
+def test_filter_model_refuses_bad_input_by_name(arguments, message) -> None:
+    call = {"scenario": DEFAULT, **arguments}
+    with pytest.raises(ValueError, match=message):
+        experiments.filter_model(call.pop("scenario"), **call)
+
+
+# --- results that draw themselves ---
+
+def test_tracking_figure_draws_this_run_its_readings_and_the_runs_compared() -> None:
+    import matplotlib.pyplot as plt
+
+    vision = experiments.track(DEFAULT)
+    fused = experiments.track(DEFAULT, FUSED)
+    fig = fused.figure("vision + proprioception", against={"vision only": vision},
+                       title="σ_v = σ_p = 1.5 cm")
+    try:
+        top, bottom = fig.axes
+        lines = {line.get_label(): line for line in top.get_lines()}
+        assert list(lines) == ["vision readings", "proprioception readings", "true position",
+                               "vision only", "vision + proprioception"]
+        np.testing.assert_array_equal(lines["proprioception readings"].get_ydata(),
+                                      fused.measurements[:, 1])
+        np.testing.assert_array_equal(lines["vision only"].get_ydata(), vision.positions)
+        np.testing.assert_array_equal(lines["vision + proprioception"].get_ydata(),
+                                      fused.positions)
+        assert lines["vision only"].get_linestyle() == "-."  # the alternative's role
+        errors = {line.get_label(): line.get_ydata() for line in bottom.get_lines()}
+        np.testing.assert_allclose(errors["vision + proprioception"],
+                                   fused.positions - DEFAULT.truth[:, 0])
+        assert top.get_title() == "σ_v = σ_p = 1.5 cm"
+    finally:
+        plt.close(fig)
+
+
+def test_tracking_figure_equals_the_figure_drawn_from_its_arrays() -> None:
+    """What notebook 01 draws today from six arrays, from the one object."""
+    import matplotlib.pyplot as plt
+    from explorer_checks import png
+
+    from lqe_helpers import figures
+
+    batch = experiments.track(DEFAULT, sigmas=[[1.5], [4.5]], runs=3)
+    by_arrays = figures.tracking_comparison_figure(
+        DEFAULT.times, DEFAULT.truth[:, 0], {"filtered estimate": (batch.positions[2, 1],
+                                                                   "estimate")},
+        readings={"vision readings": (batch.measurements[2, 1, :, 0], "vision")},
+        title="σ_v = 4.5 cm")
+    by_object = batch.figure(run=(2, 1), title="σ_v = 4.5 cm")
+    try:
+        assert png(by_object, dpi=40) == png(by_arrays, dpi=40)
+    finally:
+        plt.close(by_arrays)
+        plt.close(by_object)
+
+
+def test_delayed_tracking_figure_equals_the_figure_drawn_from_its_arrays() -> None:
+    """Notebook 05's Figure 1: ``delayed.figure()`` instead of six arrays."""
+    import matplotlib.pyplot as plt
+    from explorer_checks import png
+
+    from lqe_helpers import figures
+
+    delayed = experiments.delay_and_compensate(experiments.track(DEFAULT), 0.1)
+    assert delayed.delay == pytest.approx(0.1)
+    by_arrays = figures.delay_figure(DEFAULT.times, DEFAULT.truth[:, 0],
+                                     delayed.delayed_measurements[:, 0],
+                                     delayed.delayed_estimates[:, 0],
+                                     delayed.predictions[:, 0], 0.1)
+    by_object = delayed.figure()
+    try:
+        assert png(by_object, dpi=40) == png(by_arrays, dpi=40)
+        assert by_object.axes[0].get_title() == "Vision delayed by d = 0.1 s: the whole trial"
+    finally:
+        plt.close(by_arrays)
+        plt.close(by_object)
+
+
+def test_result_figures_refuse_what_they_cannot_draw() -> None:
+    batch = experiments.track(DEFAULT, runs=3)
+    with pytest.raises(ValueError, match=r"run must pick one run of the leading axes \(3,\)"):
+        batch.figure()
+    with pytest.raises(ValueError, match="run must pick one run"):
+        batch.figure(run=7)
+    other = experiments.track(dataclasses.replace(DEFAULT, seed=7))
+    with pytest.raises(ValueError, match="against must map labels to at most 2 Trackings of "
+                                         "this scenario"):
+        experiments.track(DEFAULT).figure(against={"other seed": other})
+    with pytest.raises(ValueError, match="against must map"):
+        experiments.track(DEFAULT).figure(against={"a": "not a tracking"})
+    with pytest.raises(ValueError, match="delay must be > 0 s"):
+        experiments.delay_and_compensate(experiments.track(DEFAULT), 0.0).figure()
+    with pytest.raises(ValueError, match="run must pick one run"):
+        experiments.delay_and_compensate(batch, 0.1).figure()

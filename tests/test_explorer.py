@@ -22,16 +22,12 @@ from matplotlib.lines import Line2D
 from matplotlib.text import Text
 from PIL import Image
 
-from lqe_helpers.explorer import (
-    Explorer,
-    encode_png,
-    float_slider,
-    log_slider,
-    pin_axis_labels,
-    reuse_panels,
-)
-from lqe_helpers.explorers._layers import LayeredCanvas
+from lqe_helpers.explorers import Explorer, float_slider, log_slider
+from lqe_helpers.explorers.layers import LayeredCanvas
+from lqe_helpers.explorers.panels import pin_axis_labels, reuse_panels
+from lqe_helpers.explorers.png import encode_picture
 from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.student_code import StudentCodeError
 
 PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
@@ -486,7 +482,7 @@ def test_a_marker_is_repainted_with_what_covers_it_only_where_it_is():
         reference.canvas.draw()
         np.testing.assert_array_equal(pixels, np.asarray(reference.canvas.buffer_rgba()))
     assert layers.fast_renders >= 3, (layers.full_renders, layers.fast_renders)
-    assert legend not in layers._background.redrawn  # far from the marker: not repainted
+    assert legend not in layers.repainted  # far from the marker: not repainted
 
 
 def test_png_encoding_keeps_every_pixel():
@@ -495,7 +491,7 @@ def test_png_encoding_keeps_every_pixel():
     opaque[..., 3] = 255
     translucent = rng.integers(0, 256, (7, 5, 4), dtype=np.uint8)
     for rgba in (opaque, translucent):
-        decoded = np.asarray(Image.open(io.BytesIO(encode_png(rgba, 90))).convert("RGBA"))
+        decoded = np.asarray(Image.open(io.BytesIO(encode_picture(rgba, 90))).convert("RGBA"))
         np.testing.assert_array_equal(decoded, rgba)
 
 
@@ -508,3 +504,67 @@ def test_static_picture_describes_the_current_view(module, factory):
     slider = next(iter(explorer.sliders.values()))
     slider.value = _positions(slider)[1]
     assert explorer.description != description  # it says which value is shown
+
+
+# A student's broken code: one line in the numbers line, never a traceback.
+
+class BreakableDrawing:
+    """draw_line, but raising ``error`` (when set) instead of drawing."""
+
+    def __init__(self) -> None:
+        self.error: Exception | None = None
+        self.calls = 0
+
+    def __call__(self, figure, *, slope):
+        self.calls += 1
+        if self.error is not None:
+            raise self.error
+        draw_line(figure, slope=slope)
+        return f"slope {slope:g} cm"
+
+
+def test_a_student_code_error_shows_one_line_keeps_the_picture_and_the_next_move_tries_again():
+    draw = BreakableDrawing()
+    explorer = Explorer("a test line", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
+                        draw, figsize=(4.0, 3.0), dpi=50)
+    picture = explorer.png
+    draw.error = StudentCodeError("my_filter raised ZeroDivisionError: division by zero\n"
+                                  "  at line 3 of your cell <here>")
+    for slope in (2.0, 2.5, 3.0):  # a loop of moves: no exception, no traceback
+        explorer.sliders["slope"].value = slope
+    message = ("my_filter raised ZeroDivisionError: division by zero at line 3 of your cell "
+               "<here>")
+    assert explorer.problem == explorer.numbers == message
+    assert explorer.readout.value == html.escape(message)
+    assert explorer.png == picture and explorer.image.value == picture
+    assert html.escape(message) in explorer.static_html()
+    assert draw.calls == 4  # every move tried again
+    draw.error = None
+    explorer.sliders["slope"].value = 3.5
+    assert (explorer.problem, explorer.numbers) == ("", "slope 3.5 cm")
+    assert explorer.readout.value == "slope 3.5 cm"
+    assert explorer.png != picture and explorer.image.value == explorer.png
+
+
+def test_any_other_exception_of_a_drawing_propagates_as_the_packs_bug():
+    draw = BreakableDrawing()
+    explorer = Explorer("a test line", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
+                        draw, figsize=(4.0, 3.0), dpi=50)
+    draw.error = ValueError("sigma_v must be > 0 cm, got -1")
+    with pytest.raises(ValueError, match="sigma_v must be > 0 cm"):
+        explorer.sliders["slope"].value = 2.0
+    assert explorer.problem == ""
+
+
+def test_an_explorer_whose_first_drawing_fails_shows_the_message_and_a_picture():
+    draw = BreakableDrawing()
+    draw.error = StudentCodeError("compensate is not written yet: replace the line "
+                                  "`raise NotImplementedError` with your code")
+    explorer = Explorer("a test line", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
+                        draw, figsize=(4.0, 3.0), dpi=50)
+    assert explorer.problem.startswith("compensate is not written yet")
+    assert explorer.png.startswith(PNG_SIGNATURE) and explorer.image.value == explorer.png
+    assert "compensate is not written yet" in explorer._repr_mimebundle_()["text/html"]
+    draw.error = None
+    explorer.sliders["slope"].value = 2.0
+    assert explorer.numbers == "slope 2 cm"

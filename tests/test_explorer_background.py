@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from explorer_checks import assert_only_numbers_change, line, png
+from explorer_checks import EXPLORER_SCENARIO, assert_only_numbers_change, explorer_draw, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, model
@@ -48,7 +48,12 @@ def test_slider_follows_the_conventions(explorer) -> None:
     low, high = background.JERK_STD_RANGE
     assert (slider.min, slider.max) == (math.log10(low), math.log10(high))
     assert slider.base == 10
-    assert slider.value == pytest.approx(DEFAULT.process_jerk_std)
+    # It starts on its grid near the scenario's σ_j, not at it (issue 15: at σ_j the
+    # crossing time in the numbers line is a task's answer in notebook 00).
+    assert slider.value == pytest.approx(background.START_JERK_STD) == pytest.approx(1000.0)
+    exponent = (math.log10(background.START_JERK_STD) - slider.min) / slider.step
+    assert exponent == pytest.approx(round(exponent))
+    assert slider.value != pytest.approx(DEFAULT.process_jerk_std, rel=0.1)
     assert slider.continuous_update is False
     # The readout must read back what it shows ("1,396" would be read as 1).
     assert slider.readout_format == ".0f"
@@ -64,7 +69,7 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
                                direct_growth(jerk_std), rtol=1e-9)
     np.testing.assert_allclose(line(growth_ax, background.REFERENCE_LABEL),
                                direct_growth(DEFAULT.process_jerk_std), rtol=1e-9)
-    noise = DEFAULT.unit_noise(sensors=("vision",))
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
     shown = window()
     truth = DEFAULT.truth[:, 0]
     np.testing.assert_allclose(line(track_ax, background.VISION_LABEL),
@@ -91,12 +96,14 @@ def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
 
 
 def test_numbers_give_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
-    growth = direct_growth(DEFAULT.process_jerk_std)
-    first = int(np.argmax(growth >= DEFAULT.amplitude))
-    assert first > 0
     reaches = ("2σ of the predicted position reaches the flight's amplitude of "
                f"{DEFAULT.amplitude:g} cm")
-    assert f"{reaches} after {first * DEFAULT.dt:.2f} s. " in explorer.numbers
+    for jerk_std in (background.START_JERK_STD, DEFAULT.process_jerk_std):
+        explorer.sliders["jerk_std"].value = jerk_std
+        growth = direct_growth(jerk_std)
+        first = int(np.argmax(growth >= DEFAULT.amplitude))
+        assert first > 0
+        assert f"{reaches} after {first * DEFAULT.dt:.2f} s. " in explorer.numbers
     # Very small σ_j: never within the second shown.
     assert not np.any(direct_growth(10.0) >= DEFAULT.amplitude)
     explorer.sliders["jerk_std"].value = 10.0
@@ -158,7 +165,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_j (cm/s³)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
-    assert explorer.numbers.startswith(f"σ_j = {DEFAULT.process_jerk_std:,.0f} cm/s³. ")
+    assert explorer.numbers.startswith("σ_j = 1,000 cm/s³. ")
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
@@ -201,15 +208,17 @@ def test_another_scenario_redraws_its_reference_curve() -> None:
                                2 * np.sqrt(P[0, 0]), rtol=1e-12)
 
 
-def test_slider_starts_at_the_scenarios_jerk_std() -> None:
-    scenario = dataclasses.replace(DEFAULT, jerk_std=300.0)
-    slider = background.explore_background(scenario).sliders["jerk_std"]
-    assert slider.value == pytest.approx(300.0)
-
-
-@pytest.mark.parametrize("jerk_std", [5.0, 2.0e5])
-def test_scenario_outside_the_slider_range_is_refused(jerk_std: float) -> None:
-    """Not clipped into the range: the explorer would show another σ_j than asked for."""
+@pytest.mark.parametrize("jerk_std", [5.0, 300.0, 2.0e5])
+def test_the_scenarios_jerk_std_is_the_reference_whatever_its_value(jerk_std: float) -> None:
+    """The slider starts at START_JERK_STD for any scenario; the scenario's σ_j, even one
+    outside the slider's range, is the reference curve, and the noise is the explorer's."""
     scenario = dataclasses.replace(DEFAULT, jerk_std=jerk_std)
-    with pytest.raises(ValueError, match=r"scenario\.process_jerk_std .*\[10, 100000\] cm/s³"):
-        background.explore_background(scenario)
+    explorer = background.explore_background(scenario)
+    assert explorer.sliders["jerk_std"].value == pytest.approx(background.START_JERK_STD)
+    growth_ax, track_ax = explorer.figure.axes
+    np.testing.assert_allclose(line(growth_ax, background.REFERENCE_LABEL)[:5],
+                               direct_growth(jerk_std, steps=4), rtol=1e-9)
+    noise = explorer_draw(scenario).unit_noise(sensors=("vision",))
+    np.testing.assert_allclose(line(track_ax, background.VISION_LABEL),
+                               (scenario.truth[:, 0] + scenario.sigma_v * noise[:, 0])[window()],
+                               atol=1e-12)

@@ -7,7 +7,7 @@ import re
 
 import numpy as np
 import pytest
-from explorer_checks import fresh_figure, lines_by_gid
+from explorer_checks import EXPLORER_SCENARIO, explorer_draw, fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
@@ -123,7 +123,7 @@ def test_slider_conventions():
 
 def test_initial_figure_is_the_question_delay():
     explorer = explore_delay()
-    noise = DEFAULT.unit_noise(sensors=("vision",))
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
     _check_figure(explorer.figure, explorer.numbers, DEFAULT.delay, noise)
     assert explorer.png.startswith(b"\x89PNG")
 
@@ -134,7 +134,7 @@ def test_slider_value_redraws_the_direct_computation(delay):
     before = explorer.png
     explorer.sliders["delay"].value = delay
     _check_figure(explorer.figure, explorer.numbers, delay,
-                  DEFAULT.unit_noise(sensors=("vision",)))
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
     assert explorer.png != before
 
 
@@ -155,7 +155,7 @@ def test_slider_value_between_steps_is_rounded_to_a_step():
     explorer = explore_delay()
     explorer.sliders["delay"].value = 0.1240000001
     _check_figure(explorer.figure, explorer.numbers, 0.12,
-                  DEFAULT.unit_noise(sensors=("vision",)))
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
 
 
 def test_redraw_reuses_axes_and_keeps_one_band():
@@ -166,7 +166,7 @@ def test_redraw_reuses_axes_and_keeps_one_band():
     assert explorer.figure.axes == axes
     assert len(axes) == 2
     _check_figure(explorer.figure, explorer.numbers, 0.3,
-                  DEFAULT.unit_noise(sensors=("vision",)))
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
 
 
 def test_slider_moves_change_the_numbers_line_not_the_figure_text():
@@ -204,7 +204,7 @@ def test_explorer_follows_its_scenario():
     scenario = dataclasses.replace(DEFAULT, sigma_v=4.5, delay=0.2)
     explorer = explore_delay(scenario)
     assert explorer.sliders["delay"].value == pytest.approx(0.2)
-    noise = scenario.unit_noise(sensors=("vision",))
+    noise = explorer_draw(scenario).unit_noise(sensors=("vision",))
     _check_figure(explorer.figure, explorer.numbers, 0.2, noise, sigma_v=4.5)
 
 

@@ -7,7 +7,7 @@ import html
 
 import numpy as np
 import pytest
-from explorer_checks import fresh_figure, lines_by_gid
+from explorer_checks import EXPLORER_SCENARIO, explorer_draw, fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
@@ -107,7 +107,8 @@ def test_slider_conventions():
 
 def test_initial_figure_is_question_c():
     explorer = explore_fusion()
-    _check_figure(explorer.figure, explorer.numbers, 1.5, 1.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, 1.5, 1.5,
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     assert explorer.png.startswith(b"\x89PNG")
 
 
@@ -118,14 +119,14 @@ def test_slider_values_redraw_the_direct_computation(sigma_v, sigma_p):
     explorer.sliders["sigma_v"].value = sigma_v
     explorer.sliders["sigma_p"].value = sigma_p
     _check_figure(explorer.figure, explorer.numbers, sigma_v, sigma_p,
-                  DEFAULT.unit_noise(sensors=FUSED))
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     assert explorer.png != before
 
 
 def test_noise_stays_fixed_across_slider_moves():
     explorer = explore_fusion()
     truth = DEFAULT.truth[:, 0]
-    expected = DEFAULT.unit_noise(sensors=FUSED)
+    expected = EXPLORER_SCENARIO.unit_noise(sensors=FUSED)
     for sigma_v, sigma_p in ((2.0, 1.5), (2.0, 5.0), (0.75, 5.0)):
         explorer.sliders["sigma_v"].value = sigma_v
         explorer.sliders["sigma_p"].value = sigma_p
@@ -156,7 +157,8 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     bands = [c for c in axes[1].collections if c.get_gid() == "fused band"]
     assert len(bands) == 1
     fresh = fresh_figure()
-    numbers = draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5)
+    numbers = draw_fusion(fresh, sigma_v=2.25, sigma_p=1.5,
+                          noise=EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     for gid in LINE_GIDS:
         np.testing.assert_array_equal(reused[gid], drawn[gid], err_msg=gid)
@@ -190,7 +192,7 @@ def test_the_right_panels_title_stays_in_the_cached_background():
         explorer.sliders["sigma_v"].value = sigma_v
         explorer.sliders["sigma_p"].value = sigma_p
     assert explorer.layers.fast_renders >= 1
-    repainted = explorer.layers._background.redrawn  # the artists a move repaints
+    repainted = explorer.layers.repainted  # the artists a move repaints
     assert any(patch.get_gid() == "weight vision" for patch in repainted)
     assert title not in repainted
 
@@ -240,7 +242,7 @@ def test_explorer_follows_its_scenario():
     explorer = explore_fusion(scenario)
     assert explorer.values == pytest.approx({"sigma_v": 2.0, "sigma_p": 3.0})
     _check_figure(explorer.figure, explorer.numbers, 2.0, 3.0,
-                  scenario.unit_noise(sensors=FUSED), scenario)
+                  explorer_draw(scenario).unit_noise(sensors=FUSED), scenario)
 
 
 @pytest.mark.parametrize(("sigma_v", "sigma_p", "name"),
@@ -257,22 +259,25 @@ def test_bad_noise_raises():
                     noise=np.zeros((DEFAULT.n_steps, 1)))
 
 
-def test_vision_only_run_is_cached_read_only_and_correct():
+def test_vision_only_run_is_correct_and_kept_while_only_sigma_p_moves():
     noise = DEFAULT.unit_noise(sensors=FUSED)
-    first = vision_only(DEFAULT, 2.0, noise)
-    # A σ_p slider move asks again with the same σ_v and noise: the same run comes back.
-    assert vision_only(DEFAULT, 2.0, noise.copy()) is first
-    assert not first.positions.flags.writeable
-    with pytest.raises(ValueError, match="read-only"):
-        first.positions[0] = 0.0
-    expected = _independent(2.0, 1.0, noise)["vision-only"]
-    np.testing.assert_allclose(first.positions, expected, rtol=1e-9, atol=1e-9)
-    # Another σ_v, or another noise draw, is another run.
-    assert vision_only(DEFAULT, 2.5, noise) is not first
+    np.testing.assert_allclose(vision_only(DEFAULT, 2.0, noise).positions,
+                               _independent(2.0, 1.0, noise)["vision-only"],
+                               rtol=1e-9, atol=1e-9)
     other = np.random.default_rng(1).standard_normal(noise.shape)
     np.testing.assert_allclose(vision_only(DEFAULT, 2.0, other).positions,
                                _independent(2.0, 1.0, other)["vision-only"],
                                rtol=1e-9, atol=1e-9)
+    # The explorer keeps the vision-only run while σ_v stays: σ_p's moves reuse it.
+    explorer = explore_fusion()
+    kept = explorer.draw.keywords["vision_runs"]
+    assert kept.computed == 1
+    for sigma_p in (3.0, 4.5, 0.75):
+        explorer.sliders["sigma_p"].value = sigma_p
+    assert kept.computed == 1
+    explorer.sliders["sigma_v"].value = 2.5
+    assert kept.computed == 2
+    assert not kept(2.5).positions.flags.writeable
 
 
 def test_static_display_carries_the_picture_and_names_the_sliders():

@@ -7,7 +7,7 @@ import html
 
 import numpy as np
 import pytest
-from explorer_checks import assert_only_numbers_change, band_matches, line, png
+from explorer_checks import EXPLORER_SCENARIO, assert_only_numbers_change, band_matches, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, metrics
@@ -42,7 +42,7 @@ def test_slider_is_logarithmic_over_the_documented_range(explorer) -> None:
 def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance) -> None:
     explorer.sliders["p0_variance"].value = p0_variance
     position_ax, velocity_ax = explorer.figure.axes
-    noise = DEFAULT.unit_noise(sensors=("vision",))
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
     truth = DEFAULT.truth
     expected = experiments.track(DEFAULT, p0_variance=p0_variance, noise=noise)
     estimates = expected.result.estimates[:SHOWN]

@@ -7,7 +7,7 @@ import html
 
 import numpy as np
 import pytest
-from explorer_checks import fresh_figure
+from explorer_checks import EXPLORER_SCENARIO, explorer_draw, fresh_figure
 from explorer_checks import lines_by_gid as _lines
 from matplotlib.figure import Figure
 from matplotlib.text import Text
@@ -17,6 +17,7 @@ from lqe_helpers.explorers.noisier_proprioception import (
     FUSED,
     QUESTION_SIGMA_P,
     SIGMA_P_RANGE,
+    START_SIGMA_P,
     THEORY_TITLE,
     draw_noisier_proprioception,
     explore_noisier_proprioception,
@@ -83,15 +84,18 @@ def test_slider_conventions():
     assert slider.min > 0
     assert slider.continuous_update is False
     assert slider.readout_format == ".1f"
+    # It starts near question (d)'s σ_p, not at it (issue 15: at 4.5 cm the weight in the
+    # numbers line is a task's answer in notebook 04), and 4.5 cm is one step away.
     assert QUESTION_SIGMA_P == 4.5
-    assert slider.value == pytest.approx(QUESTION_SIGMA_P)
-    for value in (1.5, 4.5):
+    assert slider.value == pytest.approx(START_SIGMA_P) == pytest.approx(6.0)
+    for value in (1.5, 4.5, START_SIGMA_P):
         assert (value - low) / step == pytest.approx(round((value - low) / step))
 
 
-def test_initial_figure_is_question_d():
+def test_initial_figure_is_near_question_d_on_the_explorers_draw():
     explorer = explore_noisier_proprioception()
-    _check_figure(explorer.figure, explorer.numbers, 4.5, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, START_SIGMA_P,
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     assert explorer.png.startswith(b"\x89PNG")
 
 
@@ -100,19 +104,20 @@ def test_slider_value_redraws_the_direct_computation(sigma_p):
     explorer = explore_noisier_proprioception()
     before = explorer.png
     explorer.sliders["sigma_p"].value = sigma_p
-    _check_figure(explorer.figure, explorer.numbers, sigma_p, DEFAULT.unit_noise(sensors=FUSED))
+    _check_figure(explorer.figure, explorer.numbers, sigma_p,
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     assert explorer.png != before
 
 
 def test_noise_stays_fixed_across_slider_moves():
     explorer = explore_noisier_proprioception()
     first = _lines(explorer.figure)
-    for sigma_p in (12.0, 0.5, 4.5):
+    for sigma_p in (12.0, 0.5, START_SIGMA_P):
         explorer.sliders["sigma_p"].value = sigma_p
         lines = _lines(explorer.figure)
         # Vision and its filter do not depend on σ_p at all.
         np.testing.assert_array_equal(lines["vision-only"][1], first["vision-only"][1])
-    # Back at 4.5 cm the same noise gives the same fused estimate, bit for bit.
+    # Back at the start the same noise gives the same fused estimate, bit for bit.
     np.testing.assert_array_equal(lines["fused"][1], first["fused"][1])
 
 
@@ -156,7 +161,8 @@ def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     assert explorer.figure.axes == axes
     assert len(axes) == 3
     fresh = fresh_figure()
-    numbers = draw_noisier_proprioception(fresh, sigma_p=7.5)
+    numbers = draw_noisier_proprioception(fresh, sigma_p=7.5,
+                                          noise=EXPLORER_SCENARIO.unit_noise(sensors=FUSED))
     reused, drawn = _lines(explorer.figure), _lines(fresh)
     assert set(reused) == set(drawn)
     for gid in drawn:
@@ -196,8 +202,8 @@ def test_draw_function_clears_a_foreign_figure():
 def test_explorer_follows_its_scenario():
     scenario = dataclasses.replace(DEFAULT, sigma_v=3.0, seed=2)
     explorer = explore_noisier_proprioception(scenario)
-    _check_figure(explorer.figure, explorer.numbers, 4.5, scenario.unit_noise(sensors=FUSED),
-                  scenario)
+    _check_figure(explorer.figure, explorer.numbers, START_SIGMA_P,
+                  explorer_draw(scenario).unit_noise(sensors=FUSED), scenario)
 
 
 @pytest.mark.parametrize("sigma_p", [0.0, -4.5, float("inf")])
@@ -223,7 +229,7 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
         assert description in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
     # A reader of the static page gets the trial's MSEs and the weight too, in the caption.
-    assert explorer.numbers.startswith("σ_v = 1.5 cm, σ_p = 4.5 cm. MSE of this trial")
+    assert explorer.numbers.startswith("σ_v = 1.5 cm, σ_p = 6 cm. MSE of this trial")
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 

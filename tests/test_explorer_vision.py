@@ -7,7 +7,7 @@ import html
 
 import numpy as np
 import pytest
-from explorer_checks import assert_only_numbers_change, band_matches, line, png
+from explorer_checks import EXPLORER_SCENARIO, assert_only_numbers_change, band_matches, line, png
 from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, metrics
@@ -40,7 +40,7 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: flo
     previous_png = explorer.png
     explorer.sliders["sigma_v"].value = sigma_v
     (ax,) = explorer.figure.axes
-    noise = DEFAULT.unit_noise(sensors=("vision",))
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
     truth = DEFAULT.truth[:, 0]
     # Measurements straight from Tutorial eq. (3): truth plus σ_v times the fixed noise.
     np.testing.assert_allclose(line(ax, vision.VISION_LABEL), truth + sigma_v * noise[:, 0],

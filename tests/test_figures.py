@@ -438,3 +438,91 @@ def test_assumed_noise_figure_zooms_on_the_cost_of_misjudging():
         assert "300 runs" in fig.get_suptitle()
     finally:
         plt.close(fig)
+
+
+# --- notebook 03's trial figure, and the pieces every figure module shares ---
+
+def test_fusion_trial_figure_draws_readings_truth_and_both_estimates_with_errors():
+    times = np.linspace(0.0, 1.0, 11)
+    truth = 10 * np.sin(times)
+    vision, fused = truth + 0.3, truth - 0.1
+    readings = np.stack([truth + 1.0, truth - 2.0], axis=-1)
+    fig = figures.fusion_trial_figure(times, truth, vision, fused, readings=readings,
+                                      fused_label="vision + noisier proprioception",
+                                      title="σ_p = 4.5 cm")
+    try:
+        top, bottom = fig.axes
+        labels = [line.get_label() for line in top.get_lines()]
+        assert labels == ["vision readings", "proprioception readings", "true position",
+                          "vision only", "vision + noisier proprioception"]
+        for line, expected in zip(top.get_lines(), [*readings.T, truth, vision, fused],
+                                  strict=True):
+            np.testing.assert_array_equal(line.get_ydata(), expected)
+        errors = {line.get_label(): line.get_ydata() for line in bottom.get_lines()}
+        np.testing.assert_allclose(errors["vision only"], vision - truth)
+        np.testing.assert_allclose(errors["vision + noisier proprioception"], fused - truth)
+        assert top.get_title() == "σ_p = 4.5 cm"
+    finally:
+        plt.close(fig)
+    without = figures.fusion_trial_figure(times, truth, vision, fused)
+    try:
+        assert [line.get_label() for line in without.axes[0].get_lines()] == [
+            "true position", "vision only", "vision + proprioception"]
+    finally:
+        plt.close(without)
+
+
+def test_fusion_trial_figure_refuses_readings_of_the_wrong_shape():
+    times = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ValueError, match=r"readings must have shape \(n, 2\) = \(11, 2\)"):
+        figures.fusion_trial_figure(times, times, times, times, readings=np.zeros((11, 1)))
+
+
+def test_label_axes_sets_scales_before_limits_and_draws_the_legend_asked_for():
+    from lqe_helpers.figures.common import label_axes
+
+    fig, ax = plt.subplots()
+    try:
+        ax.plot([1.0, 10.0], [1.0, 100.0], label="curve")
+        label_axes(ax, "time (s)", "error (cm²)", "a title", yscale="log", xlim=(1.0, 10.0),
+                   ylim=(0.5, 200.0), legend={"loc": "upper left", "fontsize": 8})
+        assert (ax.get_xlabel(), ax.get_ylabel(), ax.get_title()) == (
+            "time (s)", "error (cm²)", "a title")
+        assert ax.get_yscale() == "log" and ax.get_xscale() == "linear"
+        assert ax.get_xlim() == (1.0, 10.0) and ax.get_ylim() == (0.5, 200.0)
+        assert [t.get_text() for t in ax.get_legend().get_texts()] == ["curve"]
+        label_axes(ax, title="another")  # only what is given changes
+        assert (ax.get_xlabel(), ax.get_title()) == ("time (s)", "another")
+    finally:
+        plt.close(fig)
+
+
+def test_first_seconds_masks_up_to_until_and_refuses_a_non_positive_until():
+    from lqe_helpers.figures.common import first_seconds
+
+    times, shown = first_seconds([0, 1, 2, 3], 2.0)
+    assert times.dtype == float
+    np.testing.assert_array_equal(shown, [True, True, True, False])
+    with pytest.raises(ValueError, match="until must be > 0 s, got 0"):
+        first_seconds([0, 1], 0)
+
+
+def test_errorbar_intervals_and_mean_band_draw_the_means_and_their_intervals():
+    from lqe_helpers.figures.common import errorbar_intervals, mean_band
+    from lqe_helpers.metrics import Interval
+
+    intervals = [Interval(1.0, 0.5, 1.25, 10), Interval(2.0, 1.0, 3.5, 10)]
+    fig, ax = plt.subplots()
+    try:
+        errorbar_intervals(ax, np.array([1.0, 2.0]), intervals, "estimate", marker="o")
+        (container,) = ax.containers
+        np.testing.assert_array_equal(container.lines[0].get_ydata(), [1.0, 2.0])
+        segments = container.lines[2][0].get_segments()
+        np.testing.assert_array_equal([s[:, 1] for s in segments], [[0.5, 1.25], [1.0, 3.5]])
+        means = mean_band(ax, np.array([1.0, 2.0]), intervals, "prediction", "band")
+        np.testing.assert_array_equal(means, [1.0, 2.0])
+        assert ax.get_lines()[-1].get_label() == "band"
+    finally:
+        plt.close(fig)
+    with pytest.raises(ValueError, match="intervals must hold at least one interval"):
+        mean_band(None, np.array([]), [], "estimate", "empty")

@@ -51,7 +51,7 @@ CELLS = [
                   outputs=[new_output("stream", name="stdout", text="stale output of a past run")]),
     new_code_cell("print('hidden helper text')", metadata={"tags": ["remove-cell"]}),
     new_code_cell(
-        "from lqe_helpers.explorer import Explorer, float_slider\n\n\n"
+        "from lqe_helpers.explorers import Explorer, float_slider\n\n\n"
         "def draw(figure, *, a):\n"
         "    figure.clear()\n"
         "    figure.add_subplot().plot([0, 1], [0, a], label='line')\n\n\n"

@@ -1,4 +1,4 @@
-"""lqe_helpers.png: the explorers' PNG writer, read back by an independent decoder (Pillow)."""
+"""lqe_helpers.explorers.png, the PNG writer, read back by an independent decoder (Pillow)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
-from lqe_helpers import png
+from lqe_helpers.explorers import png
 
 
 @pytest.mark.parametrize("shape", [(1, 1, 3), (7, 5, 3), (3, 11, 4), (64, 48, 4)])

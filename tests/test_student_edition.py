@@ -37,7 +37,7 @@ SECOND_SOLUTION = "# Task: plot the error.\nplt.plot(times_secret, error_secret)
 ANSWER = ("### Answer to (a)\n\n"
           "The mean squared error is half the squared amplitude: a fact about marmalade sines.")
 EXPLORER = (
-    "from lqe_helpers.explorer import Explorer, float_slider\n\n\n"
+    "from lqe_helpers.explorers import Explorer, float_slider\n\n\n"
     "def draw(figure, *, amplitude):\n"
     "    figure.clear()\n"
     "    figure.add_subplot().plot([0, 1], [0, amplitude], label='line')\n\n\n"

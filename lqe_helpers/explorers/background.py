@@ -25,12 +25,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
-from .. import experiments, model, validation
-from ..explorer import Explorer, log_slider, reuse_panels, starting_value
+from .. import experiments, validation
 from ..plotting import COLORS, label_time_position, style
 from ..prediction import OpenLoop, amplitude_crossing, open_loop
 from ..scenario import DEFAULT, Scenario
-from ..steady_state import steady_state
+from .base import Explorer, with_explorer_seed
+from .panels import reuse_panels
+from .sliders import log_slider
 
 #: Seconds of open-loop prediction drawn in the left panel.
 OPEN_LOOP_DURATION = 1.0
@@ -38,6 +39,11 @@ OPEN_LOOP_DURATION = 1.0
 TRACKING_WINDOW = (1.0, 5.0)
 #: Slider range of σ_j (cm/s³): two decades either side of the matched ≈ 1 400 cm/s³.
 JERK_STD_RANGE = (10.0, 1.0e5)
+#: Where the slider starts (cm/s³): a value on its grid near, but not at, the scenario's
+#: σ_j. At the scenario's σ_j the numbers line would give the time at which 2σ reaches
+#: the amplitude, the answer of a task in notebook 00 (issue 15); the scenario's σ_j
+#: stays in the left panel as the reference curve.
+START_JERK_STD = 1000.0
 
 #: Titles of the two panels; they never change (the numbers go beside the figure).
 GROWTH_TITLE = "Uncertainty once the measurements stop"
@@ -61,9 +67,7 @@ def steady_estimate_covariance(scenario: Scenario) -> np.ndarray:
     What the observer knows about the butterfly after watching it for a while: the
     starting point of an open-loop prediction in :func:`draw_background`.
     """
-    C = model.observation_matrix(("vision",))
-    R = model.measurement_noise_covariance([scenario.sigma_v])
-    return steady_state(scenario.A, C, scenario.Q, R).estimate_covariance
+    return experiments.filter_model(scenario).steady_state().estimate_covariance
 
 
 def format_jerk(jerk_std: float) -> str:
@@ -166,11 +170,18 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     ValueError
         If ``jerk_std`` is not a finite number > 0, or ``noise`` has the wrong shape.
     """
-    jerk_std = validation.positive("jerk_std", jerk_std, "cm/s³")
+    return _draw(figure, jerk_std=validation.positive("jerk_std", jerk_std, "cm/s³"),
+                 scenario=scenario, noise=noise)
+
+
+def _draw(figure: Figure, *, jerk_std: float, scenario: Scenario,
+          noise: np.ndarray | None) -> str:
+    """:func:`draw_background` of a σ_j already checked (by it, or by the slider's range)."""
     variant = dataclasses.replace(scenario, jerk_std=jerk_std)
-    growth = open_loop(variant, np.zeros(3), steady_estimate_covariance(variant),
-                       OPEN_LOOP_DURATION)
     tracking = experiments.track(variant, noise=noise)
+    # The filter settled on vision: what the observer knows when the measurements stop.
+    settled = tracking.model.steady_state().estimate_covariance
+    growth = open_loop(variant, np.zeros(3), settled, OPEN_LOOP_DURATION)
     times = scenario.times
     window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
     expected = float(np.mean(tracking.position_variances[scenario.burn_in_steps:]))
@@ -198,23 +209,18 @@ def describe_background(*, jerk_std: float, scenario: Scenario = DEFAULT) -> str
 def explore_background(scenario: Scenario = DEFAULT) -> Explorer:
     """Slider for σ_j (log scale): open-loop growth and tracking respond together.
 
-    The slider starts at the scenario's σ_j,
-    :attr:`~lqe_helpers.scenario.Scenario.process_jerk_std`.
-
-    Raises
-    ------
-    ValueError
-        If that σ_j lies outside the slider's range :data:`JERK_STD_RANGE`.
+    The slider starts at :data:`START_JERK_STD`, not at the scenario's σ_j
+    (:attr:`~lqe_helpers.scenario.Scenario.process_jerk_std`, the reference curve);
+    vision's unit noise is drawn once from the scenario's explorer seed
+    (:func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept.
     """
-    start = starting_value("process_jerk_std", scenario.process_jerk_std, *JERK_STD_RANGE,
-                           "cm/s³")
-    noise = scenario.unit_noise(sensors=("vision",))
-    slider = log_slider("σ_j (cm/s³)", start, *JERK_STD_RANGE, steps_per_decade=8,
+    noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
+    slider = log_slider("σ_j (cm/s³)", START_JERK_STD, *JERK_STD_RANGE, steps_per_decade=8,
                         readout_format=".0f")
     return Explorer(
         "Jerk noise σ_j: open-loop growth and tracking",
         {"jerk_std": slider},
-        partial(draw_background, scenario=scenario, noise=noise),
+        partial(_draw, scenario=scenario, noise=noise),
         figsize=(10.0, 4.8),
         describe=partial(describe_background, scenario=scenario),
     )

@@ -11,16 +11,18 @@ explorer shows between the sliders and the picture.
 
 Speed: building the axes, ticks and legends costs more than the filter run, so
 :func:`draw_bias` builds the panels once per figure and afterwards only replaces the
-data of the same artists. A move recomputes only what its slider changes
-(:class:`_Runs`): the filter's covariances and gains depend on σ_a and σ_v alone, and
-the filter is linear in the input, so a move of b reuses them and shifts the
-estimates by b times the filter's response to a unit input; dead reckoning depends on
-b and σ_a alone, so a move of σ_v reuses it. Only the last values are kept (no cache
-of earlier ones): going back to a σ pays for its filter run again.
+data of the same artists. A move recomputes only what its slider changes: the
+filter run depends on σ_a and σ_v alone, since the filter is linear in its input and
+a move of b only shifts the estimates by b times the filter's response to a unit
+input (:func:`~lqe_helpers.bias_model.unbiased_run`, the same path notebook 06's
+:func:`~lqe_helpers.bias_model.track_with_input` takes). The explorer keeps the run
+of the last (σ_a, σ_v) only (:class:`~lqe_helpers.explorers.cache.LastResults`):
+going back to a σ pays for its filter run again.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
 
@@ -31,18 +33,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from .. import bias_model, simulation, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    log_slider,
-    reuse_panels,
-    starting_value,
-)
-from ..filter import FilterResult, kalman_filter
+from .. import bias_model
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer, with_explorer_seed
+from .cache import LastResults
+from .panels import DATA_UNDER_LINES, reuse_panels
+from .sliders import float_slider, log_slider, starting_value
 
 #: Slider range of the true bias b (cm/s²): up to 60 % of the path's peak acceleration.
 BIAS_RANGE = (-60.0, 60.0)
@@ -177,83 +174,15 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
     ValueError
         If a value is out of range, or ``noise`` has the wrong shape.
     """
-    return _draw_tracking(figure, _Runs(scenario, noise).tracking(bias, sigma_a, sigma_v))
+    run = bias_model.unbiased_run(scenario, sigma_a, sigma_v, noise=noise)
+    return _draw_tracking(figure, run.at_bias(bias))
 
 
-class _Runs:
-    """The run of :func:`~lqe_helpers.bias_model.track_with_input` at given slider values.
-
-    For one scenario and one fixed draw of unit noise. Equal to
-    ``track_with_input(scenario, bias, sigma_a, sigma_v, noise=noise)`` to rounding,
-    but it recomputes only what changed since the last call:
-
-    * the covariances and gains of the filter depend on σ_a (Q) and σ_v (R) alone;
-      so do the estimates without the bias and the response to a unit constant input,
-      filtered together in one run (one Riccati recursion, two estimate sequences).
-      The filter is linear in its input, so the estimates for a bias b are the first
-      plus b times the second. Kept for the last (σ_a, σ_v) only.
-    * dead reckoning and the acceleration readings depend on b and σ_a alone. Kept
-      for the last (b, σ_a) only.
-
-    One entry each, on purpose: a slider moved back to an earlier σ pays for its
-    filter run again, as the first time.
-    """
-
-    def __init__(self, scenario: Scenario, noise: np.ndarray | None = None) -> None:
-        validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
-        if noise is None:
-            noise = bias_model.unit_noise(scenario)
-        self.noise = validation.shaped_array("noise", noise, (scenario.n_steps, 2),
-                                             ", ".join(bias_model.NOISE_COLUMNS))
-        self.scenario = scenario
-        self._accelerations = bias_model.step_accelerations(scenario)
-        #: ((σ_a, σ_v), measurements, the filter run of [unbiased, unit input]) or None.
-        self._filtered: tuple[tuple[float, float], np.ndarray, FilterResult] | None = None
-        #: ((b, σ_a), readings, dead reckoning) or None.
-        self._reckoned: tuple[tuple[float, float], np.ndarray, np.ndarray] | None = None
-
-    def tracking(self, bias: float, sigma_a: float, sigma_v: float) -> bias_model.InputTracking:
-        """The run at true bias ``bias`` (cm/s²), σ_a (cm/s², > 0) and σ_v (cm, > 0)."""
-        bias = validation.finite_number("bias", bias, "cm/s²")
-        sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
-        sigma_v = validation.positive("sigma_v", sigma_v, "cm")
-        scenario = self.scenario
-        truth = bias_model.true_states(scenario, bias)
-        if self._filtered is None or self._filtered[0] != (sigma_a, sigma_v):
-            measurements = simulation.measure(truth[:, 0], self.noise[:, :1],
-                                              np.array([sigma_v]))
-            unbiased = bias_model.acceleration_readings(self._accelerations, 0.0, sigma_a,
-                                                        self.noise[:, 1])
-            # Run 0: the measurements and the unbiased readings; run 1: no measurement,
-            # an input of 1 cm/s² at every step. Both share the gains.
-            runs = kalman_filter(np.stack([measurements, np.zeros_like(measurements)]),
-                                 **bias_model.filter_model(scenario, sigma_a, sigma_v),
-                                 u=np.stack([unbiased, np.ones_like(unbiased)])[..., None])
-            _read_only(measurements, runs.estimates)
-            self._filtered = ((sigma_a, sigma_v), measurements, runs)
-        _, measurements, runs = self._filtered
-        if self._reckoned is None or self._reckoned[0] != (bias, sigma_a):
-            readings = bias_model.acceleration_readings(self._accelerations, bias, sigma_a,
-                                                        self.noise[:, 1])
-            drift = bias_model.dead_reckoning(readings, bias_model.initial_state(scenario, bias),
-                                              scenario.dt)
-            _read_only(readings, drift)
-            self._reckoned = ((bias, sigma_a), readings, drift)
-        _, readings, drift = self._reckoned
-        result = FilterResult(
-            estimates=runs.estimates[0] + bias * runs.estimates[1],
-            gains=runs.gains[0],
-            covariances=runs.covariances[0],
-            estimate_covariances=runs.estimate_covariances[0],
-        )
-        return bias_model.InputTracking(scenario, bias, sigma_a, sigma_v, truth, readings,
-                                        measurements, result, drift)
-
-
-def _read_only(*arrays: np.ndarray) -> None:
-    """Lock arrays that later runs share, so no caller can alter a kept run."""
-    for array in arrays:
-        array.flags.writeable = False
+def _draw(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
+          unbiased_runs: Callable[[float, float], bias_model.UnbiasedRun]) -> str:
+    """:func:`draw_bias` for the explorer: ``unbiased_runs(σ_a, σ_v)`` makes or keeps the filter
+    run at b = 0, which a move of b only shifts (``UnbiasedRun.at_bias``)."""
+    return _draw_tracking(figure, unbiased_runs(sigma_a, sigma_v).at_bias(bias))
 
 
 def _draw_tracking(figure: Figure, tracking: bias_model.InputTracking) -> str:
@@ -284,12 +213,6 @@ def _bias_numbers(tracking: bias_model.InputTracking) -> str:
             f"the path at {scenario.duration:g} s.")
 
 
-def _draw_runs(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
-               runs: _Runs) -> str:
-    """:func:`draw_bias` with the explorer's :class:`_Runs`, which keeps the last run."""
-    return _draw_tracking(figure, runs.tracking(bias, sigma_a, sigma_v))
-
-
 def describe_bias(*, bias: float, sigma_a: float, sigma_v: float) -> str:
     """What :func:`draw_bias` shows at these slider values (its alt text)."""
     return (f"First {WINDOW:g} s of one run with an acceleration signal biased by "
@@ -302,8 +225,12 @@ def describe_bias(*, bias: float, sigma_a: float, sigma_v: float) -> str:
 def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
     """Sliders for b (cm/s²), σ_a (cm/s², log scale) and σ_v (cm) over :func:`draw_bias`.
 
-    Both noise streams are drawn once from the scenario's seed and kept, so a slider
-    rescales the same noise instead of drawing new noise. b and σ_a start at
+    Both noise streams are drawn once from the scenario's explorer seed (another draw
+    than the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept,
+    so a slider rescales the same noise instead of drawing new noise. The filter run
+    at b = 0 is kept for the last (σ_a, σ_v) (:class:`~lqe_helpers.explorers.cache.LastResults`):
+    a move of b only shifts it, as notebook 06's own runs are made
+    (:func:`~lqe_helpers.bias_model.track_with_input`). b and σ_a start at
     :data:`~lqe_helpers.bias_model.DEFAULT_BIAS` and
     :data:`~lqe_helpers.bias_model.DEFAULT_SIGMA_A`, σ_v at the scenario's.
 
@@ -313,7 +240,7 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
         If ``scenario.sigma_v`` lies outside the slider's range :data:`SIGMA_V_RANGE`.
     """
     start_sigma_v = starting_value("sigma_v", scenario.sigma_v, *SIGMA_V_RANGE, "cm")
-    noise = bias_model.unit_noise(scenario)
+    noise = bias_model.unit_noise(with_explorer_seed(scenario))
     sliders = {
         "bias": float_slider("b (cm/s²)", bias_model.DEFAULT_BIAS, *BIAS_RANGE, BIAS_STEP,
                              readout_format=".0f"),
@@ -325,7 +252,8 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
     return Explorer(
         "A biased acceleration signal corrected by vision",
         sliders,
-        partial(_draw_runs, runs=_Runs(scenario, noise)),
+        partial(_draw, unbiased_runs=LastResults(partial(bias_model.unbiased_run, scenario,
+                                                         noise=noise))),
         figsize=(10.0, 4.6),
         describe=describe_bias,
     )

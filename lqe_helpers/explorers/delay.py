@@ -12,6 +12,7 @@ line of text, which the explorer shows between the slider and the picture.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
 
@@ -22,9 +23,12 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from .. import experiments
-from ..explorer import DATA_UNDER_LINES, Explorer, float_slider, reuse_panels, starting_value
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer, with_explorer_seed
+from .cache import LastResults
+from .panels import DATA_UNDER_LINES, reuse_panels
+from .sliders import float_slider, starting_value
 
 #: Longest delay the slider offers (s): a quarter of the butterfly's period, far past
 #: the point where prediction stops paying off.
@@ -188,7 +192,9 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
 
     The slider runs from 0 to :data:`MAX_DELAY` (or the last whole step before the
     end of the trial, if that is shorter) in steps of Δt, starting at the scenario's
-    delay; a value between steps is rounded to the nearest step.
+    delay; a value between steps is rounded to the nearest step. Vision's noise is
+    drawn from the scenario's explorer seed (another draw than the tasks',
+    :func:`~lqe_helpers.explorers.base.with_explorer_seed`).
 
     Raises
     ------
@@ -198,10 +204,10 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
     high = math.floor(min(MAX_DELAY, (scenario.n_steps - 1) * scenario.dt) / scenario.dt
                       + 1e-9) * scenario.dt
     start = starting_value("delay", scenario.delay, 0.0, high, "s")
-    noise = scenario.unit_noise(sensors=SENSORS)
+    noise = with_explorer_seed(scenario).unit_noise(sensors=SENSORS)
     # A delay changes only when the filter's output arrives, not the output itself:
-    # filter the fixed noise once and let the slider shift and predict that run.
-    tracking = experiments.track(scenario, SENSORS, noise=noise)
+    # filter the fixed noise once, keep it, and let the slider shift and predict it.
+    run = LastResults(partial(experiments.track, scenario, SENSORS, noise=noise))
     decimals = max(2, math.ceil(-math.log10(scenario.dt) - 1e-9))
     slider = float_slider("delay (s)", value=start, low=0.0, high=high,
                           step=scenario.dt, readout_format=f".{decimals}f")
@@ -209,7 +215,7 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
         "Sensory delay and its compensation: truth, delayed vision, delayed estimate and "
         "prediction",
         {"delay": slider},
-        partial(_draw_on_grid, tracking=tracking),
+        partial(_draw, run=run),
         figsize=(9.0, 5.2),
         describe=partial(describe_delay, scenario=scenario),
     )
@@ -224,7 +230,9 @@ def describe_delay(*, delay: float, scenario: Scenario = DEFAULT) -> str:
             f"prediction, with both estimates' errors below.")
 
 
-def _draw_on_grid(figure: Figure, *, delay: float, tracking: experiments.Tracking) -> str:
-    """Round the slider's float to the nearest whole step, then draw the fixed run."""
+def _draw(figure: Figure, *, delay: float,
+                  run: Callable[[], experiments.Tracking]) -> str:
+    """Round the slider's float to the nearest whole step, then draw the kept run."""
+    tracking = run()
     dt = tracking.scenario.dt
     return _draw_tracking(figure, round(delay / dt) * dt, tracking)

@@ -11,7 +11,8 @@ function returns them as one line of text, shown between the sliders and the pic
 
 from __future__ import annotations
 
-from functools import lru_cache, partial
+from collections.abc import Callable
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -21,33 +22,31 @@ from matplotlib.patches import Rectangle
 from matplotlib.text import Annotation
 
 from .. import experiments, validation
-from ..cue_combination import reliability_weights
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    pin_axis_labels,
-    reuse_panels,
-    starting_value,
-)
 from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
-from ._trial import (
+from .base import Explorer, with_explorer_seed
+from .cache import LastResults
+from .common import (
     TrialLine,
     TrialPanels,
     build_trial_panels,
     estimate_lines,
     legend_handles,
+    position_shares,
     trial_numbers,
 )
+from .panels import DATA_UNDER_LINES, pin_axis_labels, reuse_panels
+from .sliders import float_slider, starting_value
 
 #: The fused filter's sensors, in the column order of its noise and gains.
 FUSED = ("vision", "proprioception")
 
 #: Slider range for either σ (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_RANGE = (0.5, 6.0, 0.25)
+#: How many vision-only runs (one per σ_v, about 0.2 MB each) the explorer keeps.
+VISION_RUNS_KEPT = 16
 
-#: Plotted lines by gid (see :data:`~._trial.TrialLine`).
+#: Plotted lines by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "vision readings": (0, "vision", "vision readings"),
     "proprioception readings": (0, "proprioception", "proprioception readings"),
@@ -74,30 +73,14 @@ def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarra
                                    ", ".join(FUSED))
 
 
-@lru_cache(maxsize=16)
-def _vision_only(scenario: Scenario, sigma_v: float, noise: bytes) -> experiments.Tracking:
-    """The vision-only filter on one trial; cached, as it ignores σ_p's slider.
-
-    ``noise`` is the unit visual noise, shape (n,), as raw float64 bytes (hashable).
-    """
-    column = np.frombuffer(noise, dtype=float).reshape(-1, 1)
-    tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=column)
-    # Shared between calls: make sure no caller can change the cached run.
-    result = tracking.result
-    for array in (tracking.measurements, result.estimates, result.gains, result.covariances,
-                  result.estimate_covariances):
-        array.setflags(write=False)
-    return tracking
-
-
 def vision_only(scenario: Scenario, sigma_v: float, noise: np.ndarray) -> experiments.Tracking:
     """Vision-only tracking of one trial with unit noise ``noise[:, 0]`` scaled by ``sigma_v``.
 
-    Moving another slider (σ_p) does not change this run, so it is computed once per
-    (scenario, σ_v, noise) and reused; its arrays are read-only.
+    ``noise`` (n, 2) as :func:`unit_noise` gives it. Moving σ_p does not change this
+    run, so the explorers keep it between moves
+    (:class:`~lqe_helpers.explorers.cache.LastResults`).
     """
-    visual = np.ascontiguousarray(noise[:, 0], dtype=float)
-    return _vision_only(scenario, float(sigma_v), visual.tobytes())
+    return experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
 
 
 def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
@@ -148,17 +131,23 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     ValueError
         If a σ is not a finite number > 0, or ``noise`` has the wrong shape.
     """
-    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
-    sigma_p = validation.positive("sigma_p", sigma_p, "cm")
     noise = unit_noise(scenario, noise)
-    vision = vision_only(scenario, sigma_v, noise)
+    return _draw(figure, sigma_v=validation.positive("sigma_v", sigma_v, "cm"),
+                 sigma_p=validation.positive("sigma_p", sigma_p, "cm"), scenario=scenario,
+                 noise=noise, vision_runs=partial(vision_only, scenario, noise=noise))
+
+
+def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
+          noise: np.ndarray,
+          vision_runs: Callable[[float], experiments.Tracking]) -> str:
+    """:func:`draw_fusion` of σ's already checked; ``vision_runs(σ_v)`` makes or keeps
+    the vision-only run."""
+    vision = vision_runs(sigma_v)
     fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
     truth = scenario.truth[:, 0]
-    # Share of the position correction each sense receives. The gain is K = P Cᵀ R⁻¹
-    # (P the estimate's covariance) and C's rows are identical, so K's position row
-    # is P[0, 0] · (1/σ_v², 1/σ_p²) at every step: the shares of the settled gain
-    # are exactly the reliability weights (tests/test_cue_combination.py).
-    weights = reliability_weights([sigma_v, sigma_p])
+    # Share of the position correction each sense receives in the settled filter: the
+    # reliability weights 1/σ² normalised, read off the fused filter's own gain.
+    weights = position_shares(fused.model.steady_state().gain)
 
     panels = reuse_panels(figure, _build, scenario)
     data = {
@@ -232,8 +221,10 @@ def describe_fusion(*, sigma_v: float, sigma_p: float) -> str:
 def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
     """Sliders for σ_v and σ_p over vision-only and fused tracking of one fixed trial.
 
-    The unit noise is drawn once from the scenario and kept, so a slider changes
-    only how loud a sense is, never its noise pattern. The sliders start at the
+    The unit noise is drawn once from the scenario's explorer seed (another draw than
+    the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so a
+    slider changes only how loud a sense is, never its noise pattern; moving σ_p (or σ_v
+    back to a recent value) reuses a kept vision-only run. The sliders start at the
     scenario's σ_v and σ_p (question (c): 1.5 cm each).
 
     Raises
@@ -249,6 +240,10 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
         "sigma_v": float_slider("σ_v (cm)", start_v, low, high, step),
         "sigma_p": float_slider("σ_p (cm)", start_p, low, high, step),
     }
-    draw = partial(draw_fusion, scenario=scenario, noise=unit_noise(scenario))
+    noise = unit_noise(with_explorer_seed(scenario))
+    # The vision-only runs of the last VISION_RUNS_KEPT σ_v: moving σ_p, or σ_v back to a
+    # recent value, reuses one.
+    vision_runs = LastResults(partial(vision_only, scenario, noise=noise), size=VISION_RUNS_KEPT)
+    draw = partial(_draw, scenario=scenario, noise=noise, vision_runs=vision_runs)
     return Explorer("Vision alone against vision + proprioception", sliders, draw,
                     figsize=(10.0, 5.0), describe=describe_fusion)

@@ -27,16 +27,11 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    log_slider,
-    reuse_panels,
-    set_ylim_in_steps,
-    starting_value,
-)
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer, with_explorer_seed
+from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .sliders import log_slider, starting_value
 
 #: Slider range for P0 (cm², same number for cm²/s² and cm²/s⁴): from "certain of
 #: the initial guess" to "no idea at all".
@@ -131,7 +126,13 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     ValueError
         If ``p0_variance`` is not a finite number > 0, or ``noise`` has the wrong shape.
     """
-    p0_variance = validation.positive("p0_variance", p0_variance, "cm²")
+    return _draw(figure, p0_variance=validation.positive("p0_variance", p0_variance, "cm²"),
+                 scenario=scenario, noise=noise)
+
+
+def _draw(figure: Figure, *, p0_variance: float, scenario: Scenario,
+          noise: np.ndarray | None) -> str:
+    """:func:`draw_initial_covariance` of a P0 already checked (by it, or by the slider)."""
     tracking = experiments.track(scenario, ("vision",), p0_variance=p0_variance, noise=noise)
     burn_in = scenario.burn_in_steps
     early_mse = float(metrics.mse(tracking.positions[:burn_in], scenario.truth[:burn_in, 0]))
@@ -168,8 +169,9 @@ def describe_initial_covariance(*, p0_variance: float, scenario: Scenario = DEFA
 def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     """Logarithmic slider for P0 (cm²) over :func:`draw_initial_covariance`.
 
-    The unit noise is drawn once from the scenario's seed and kept, so moving the
-    slider changes only P0, never the noise the filter sees.
+    The unit noise is drawn once from the scenario's explorer seed (another draw than
+    the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so
+    moving the slider changes only P0, never the noise the filter sees.
 
     Parameters
     ----------
@@ -188,12 +190,12 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     """
     low, high = P0_RANGE
     start = starting_value("p0_variance", scenario.p0_variance, low, high, "cm²")
-    noise = scenario.unit_noise(sensors=("vision",))
+    noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
     slider = log_slider("P0 (cm²)", start, low, high, steps_per_decade=P0_STEPS_PER_DECADE,
                         readout_format=".3g")
     return Explorer(
         "The start of vision-only tracking as the initial covariance P0 changes",
         {"p0_variance": slider},
-        partial(draw_initial_covariance, scenario=scenario, noise=noise),
+        partial(_draw, scenario=scenario, noise=noise),
         describe=partial(describe_initial_covariance, scenario=scenario),
     )

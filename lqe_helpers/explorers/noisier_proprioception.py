@@ -11,6 +11,7 @@ returns them as one line of text, shown between the slider and the picture.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
 
@@ -19,24 +20,30 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
-from .. import experiments, model, validation
-from ..cue_combination import reliability_weights
-from ..explorer import Explorer, float_slider, pin_axis_labels, reuse_panels
+from .. import experiments, validation
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
-from ..steady_state import steady_state
-from ._trial import (
+from .base import Explorer, with_explorer_seed
+from .cache import LastResults
+from .common import (
     TrialLine,
     TrialPanels,
     build_trial_panels,
     estimate_lines,
     legend_handles,
+    position_shares,
     trial_numbers,
 )
 from .fusion import FUSED, unit_noise, vision_only
+from .panels import pin_axis_labels, reuse_panels
+from .sliders import float_slider
 
-#: σ_p (cm) of question (d), where the slider starts.
+#: σ_p (cm) of question (d).
 QUESTION_SIGMA_P = 4.5
+#: Where the slider starts (cm): near question (d)'s σ_p, not at it. At 4.5 cm the
+#: numbers line would give proprioception's steady-state weight, 10.0 %, the answer of
+#: a task in notebook 04 (issue 15).
+START_SIGMA_P = 6.0
 
 #: Slider range for σ_p (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
 SIGMA_P_RANGE = (0.5, 30.0, 0.5)
@@ -47,7 +54,7 @@ CURVE_RANGE = (0.3, 100.0)
 #: Title of the right panel; it never changes, so it stays in the cached background.
 THEORY_TITLE = "steady state"
 
-#: Plotted lines of the left column by gid (see :data:`~._trial.TrialLine`).
+#: Plotted lines of the left column by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
     "truth": (0, "truth", "true position"),
     "vision-only": (0, "alternative", "vision-only estimate"),
@@ -86,11 +93,9 @@ def steady_position_variances(scenario: Scenario, sigma_v: float,
         raise ValueError(
             f"sigma_p must be a 1-D array of values > 0 cm, got {np.ravel(sigma_p)[:6].tolist()}"
         )
-    alone = steady_state(scenario.A, model.observation_matrix(("vision",)), scenario.Q,
-                         model.measurement_noise_covariance([sigma_v]))
+    alone = experiments.filter_model(scenario, ("vision",), [sigma_v]).steady_state()
     sigmas = np.stack([np.full_like(sigma_p, sigma_v), sigma_p], axis=-1)
-    both = steady_state(scenario.A, model.observation_matrix(FUSED), scenario.Q,
-                        model.measurement_noise_covariance(sigmas))
+    both = experiments.filter_model(scenario, FUSED, sigmas).steady_state()
     return float(alone.estimate_covariance[0, 0]), both.estimate_covariance[:, 0, 0]
 
 
@@ -141,21 +146,31 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     ValueError
         If ``sigma_p`` is not a finite number > 0, or ``noise`` has the wrong shape.
     """
-    sigma_p = validation.positive("sigma_p", sigma_p, "cm")
     noise = unit_noise(scenario, noise)
+    return _draw(figure, sigma_p=validation.positive("sigma_p", sigma_p, "cm"),
+                 scenario=scenario, noise=noise,
+                 vision_run=partial(vision_only, scenario, scenario.sigma_v, noise))
+
+
+def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarray,
+          vision_run: Callable[[], experiments.Tracking]) -> str:
+    """:func:`draw_noisier_proprioception` of a σ_p already checked; ``vision_run()``
+    makes or keeps the vision-only run (σ_v is the scenario's, whatever the slider)."""
     sigma_v = scenario.sigma_v
-    vision = vision_only(scenario, sigma_v, noise)
+    vision = vision_run()
     fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
     truth = scenario.truth[:, 0]
-    _, theory_now = steady_position_variances(scenario, sigma_v, np.array([sigma_p]))
-    # Proprioception's share of the settled position gain: its reliability weight
-    # (see draw_fusion in lqe_helpers.explorers.fusion for why they are equal).
-    weight_p = float(reliability_weights([sigma_v, sigma_p])[1])
+    # The theory at the slider's σ_p: the steady state of the very model the fused
+    # filter ran with (the curve's value at this σ_p), and proprioception's share of
+    # its settled position gain (its reliability weight).
+    settled = fused.model.steady_state()
+    theory_now = settled.estimate_covariance[0, 0]
+    weight_p = float(position_shares(settled.gain)[1])
 
     panels = reuse_panels(figure, _build, scenario)
     for gid, values in estimate_lines(truth, vision, fused).items():
         panels.trial.lines[gid].set_ydata(values)
-    panels.marker.set_data([sigma_p], theory_now)
+    panels.marker.set_data([sigma_p], [theory_now])
     return (f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} "
             f"Proprioception's weight in the steady state: {100 * weight_p:.1f} %.")
 
@@ -209,14 +224,18 @@ def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFA
 def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
     """A σ_p slider over vision-only and fused tracking of one fixed trial.
 
-    The unit noise is drawn once and kept, so moving σ_p rescales the same
-    proprioceptive noise pattern; vision's readings never change. The slider starts
-    at question (d)'s σ_p = 4.5 cm; σ_v is the scenario's.
+    The unit noise is drawn once from the scenario's explorer seed (another draw than
+    the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so
+    moving σ_p rescales the same proprioceptive noise pattern; vision's readings and
+    the vision-only run never change. The slider starts at :data:`START_SIGMA_P`, near
+    question (d)'s σ_p; σ_v is the scenario's.
     """
     low, high, step = SIGMA_P_RANGE
-    sliders = {"sigma_p": float_slider("σ_p (cm)", QUESTION_SIGMA_P, low, high, step,
+    sliders = {"sigma_p": float_slider("σ_p (cm)", START_SIGMA_P, low, high, step,
                                        readout_format=".1f")}
-    draw = partial(draw_noisier_proprioception, scenario=scenario, noise=unit_noise(scenario))
+    noise = unit_noise(with_explorer_seed(scenario))
+    vision_run = LastResults(partial(vision_only, scenario, scenario.sigma_v, noise))
+    draw = partial(_draw, scenario=scenario, noise=noise, vision_run=vision_run)
     return Explorer("How much does a noisier proprioception help?", sliders, draw,
                     figsize=(10.0, 5.0),
                     describe=partial(describe_noisier_proprioception, scenario=scenario))

@@ -8,7 +8,7 @@ between the slider and the figure.
 
 Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
 filter run, so :func:`draw_vision` builds the panel once per figure
-(:func:`~lqe_helpers.explorer.reuse_panels`) and afterwards only replaces the data
+(:func:`~lqe_helpers.explorers.panels.reuse_panels`) and afterwards only replaces the data
 and limits of the same artists; the numbers stay out of the figure, where text would
 be rendered again on every move. The picture is the same as a fresh drawing (a test
 checks the PNG bytes); only the redraw is faster.
@@ -26,16 +26,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments, validation
-from ..explorer import (
-    DATA_UNDER_LINES,
-    Explorer,
-    float_slider,
-    reuse_panels,
-    set_ylim_in_steps,
-    starting_value,
-)
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
+from .base import Explorer, with_explorer_seed
+from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .sliders import float_slider, starting_value
 
 #: Slider range for σ_v (cm): from a nearly perfect eye to noise as large as the flight.
 SIGMA_V_RANGE = (0.1, 10.0)
@@ -109,7 +104,13 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
     ValueError
         If ``sigma_v`` is not a finite number > 0, or ``noise`` has the wrong shape.
     """
-    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
+    return _draw(figure, sigma_v=validation.positive("sigma_v", sigma_v, "cm"),
+                 scenario=scenario, noise=noise)
+
+
+def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
+          noise: np.ndarray | None) -> str:
+    """:func:`draw_vision` of a σ_v already checked (by it, or by the slider's range)."""
     tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise)
     measured = tracking.measurements[:, 0]
     estimate = tracking.positions
@@ -139,8 +140,9 @@ def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT) -> str:
 def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
     """Slider for σ_v (cm) over :func:`draw_vision`, with one fixed noise pattern.
 
-    The unit noise is drawn once from the scenario's seed and kept, so moving the
-    slider rescales the same noise instead of drawing new noise.
+    The unit noise is drawn once from the scenario's explorer seed (another draw than
+    the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so
+    moving the slider rescales the same noise instead of drawing new noise.
 
     Parameters
     ----------
@@ -159,11 +161,11 @@ def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
     """
     low, high = SIGMA_V_RANGE
     start = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
-    noise = scenario.unit_noise(sensors=("vision",))
+    noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
     slider = float_slider("σ_v (cm)", start, low, high, SIGMA_V_STEP, readout_format=".1f")
     return Explorer(
         "Vision-only tracking as the vision noise σ_v changes",
         {"sigma_v": slider},
-        partial(draw_vision, scenario=scenario, noise=noise),
+        partial(_draw, scenario=scenario, noise=noise),
         describe=partial(describe_vision, scenario=scenario),
     )

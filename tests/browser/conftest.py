@@ -109,7 +109,7 @@ def write_harness_notebook(path: Path) -> None:
     cell after it raises; the last cell never runs.
     """
     live = '''import numpy as np
-from lqe_helpers.explorer import Explorer, float_slider, log_slider
+from lqe_helpers.explorers import Explorer, float_slider, log_slider
 
 
 def draw(figure, *, amplitude, variance):

@@ -148,6 +148,15 @@ class LayeredCanvas:
         self.full_renders = 0
         self.fast_renders = 0
 
+    @property
+    def repainted(self) -> tuple[Artist, ...]:
+        """The artists a move repaints over the cached layer (empty before the first one).
+
+        The changed artists of the last full render and every artist that may paint
+        over them, in drawing order: what the next fast render will paint again.
+        """
+        return () if self._background is None else tuple(self._background.redrawn)
+
     def render(self) -> np.ndarray:
         """Bring the canvas up to date with the figure; its RGBA pixels, shape (h, w, 4).
 

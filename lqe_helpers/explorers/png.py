@@ -71,3 +71,15 @@ def encode(pixels: np.ndarray, dpi: float, level: int = COMPRESS_LEVEL) -> bytes
         _chunk(b"IDAT", zlib.compress(rows.tobytes(), level)),
         _chunk(b"IEND", b""),
     ])
+
+
+def encode_picture(rgba: np.ndarray, dpi: float) -> bytes:
+    """The picture ``rgba`` (uint8, shape (h, w, 4)) as PNG bytes, fast rather than small.
+
+    An opaque picture is stored as RGB, a quarter fewer bytes to compress; :func:`encode`
+    skips row filters and uses zlib's fastest level, since for a widget on the same
+    machine encoding time matters more than bytes. No metadata besides the resolution,
+    so equal pictures give equal bytes.
+    """
+    opaque = bool(rgba[..., 3].min() == 255)
+    return encode(np.ascontiguousarray(rgba[..., :3] if opaque else rgba), dpi)

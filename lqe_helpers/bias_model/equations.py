@@ -1,30 +1,17 @@
-"""A measured acceleration with a bias, used as a known input (Lesson 0.5, bonus notebook).
+"""The biased-input model's equations: its matrices, the hand, the signal, dead reckoning.
 
-State ``z = [p, v, b]``: position (cm), velocity (cm/s) and the bias b (cm/s²) of an
-acceleration signal ``a_r = a + b + noise``. The signal is not measured against the
-state; it drives the prediction as an input, ``z_{j+1} = F z_j + G u_j`` (Lesson 0.5
-eq. (4)), and vision, which reads the position, corrects what the input gets wrong.
-
-In the nervous system the input could be an efference copy of the motor command or
-the otoliths' linear acceleration signal, both of which can carry a slowly varying
-offset; here the moving target is the hand of :data:`~lqe_helpers.scenario.DEFAULT`,
-whose path is the tutorial's sinusoid.
-
-Time convention (that of :func:`~lqe_helpers.filter.kalman_filter`): ``u_j`` is the
-reading over the step that ends at sample j, from ``t_j − Δt`` to ``t_j``, and the
-filter's ``z0`` is the estimate of the state at ``t = −Δt``.
+Part of :mod:`lqe_helpers.bias_model` (notebook 06, Lesson 0.5), whose docstring gives
+the state ``[p, v, b]`` and the time convention; the filter that uses these equations
+and its runs are in :mod:`lqe_helpers.bias_model.tracking`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from . import metrics, model, simulation, validation
-from .filter import FilterResult, kalman_filter
-from .prediction import propagate_covariance
-from .scenario import Scenario
+from .. import _matrices, model, simulation, validation
+from ..prediction import propagate_covariance
+from ..scenario import Scenario
 
 #: Column order of :func:`unit_noise`: vision's noise, then the acceleration signal's.
 NOISE_COLUMNS = ("vision", "acceleration")
@@ -34,9 +21,6 @@ NOISE_COLUMNS = ("vision", "acceleration")
 DEFAULT_BIAS = 20.0
 #: Noise σ_a of each acceleration reading (cm/s²), also a fifth of the peak acceleration.
 DEFAULT_SIGMA_A = 20.0
-#: The filter's prior standard deviation of the bias (cm/s²): the observer allows
-#: offsets up to about half the peak acceleration before it has seen anything.
-DEFAULT_BIAS_PRIOR_STD = 50.0
 
 
 def transition_matrix(dt: float) -> np.ndarray:
@@ -98,8 +82,7 @@ def process_noise_covariance(dt: float, sigma_a: float) -> np.ndarray:
         Q in cm², cm²/s, cm²/s² (zero in the bias row and column).
     """
     sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
-    g = input_matrix(dt)
-    return sigma_a**2 * (g @ g.T)
+    return _matrices.input_noise_covariance(input_matrix(dt), sigma_a)
 
 
 def step_accelerations(scenario: Scenario) -> np.ndarray:
@@ -297,167 +280,3 @@ def unit_noise(scenario: Scenario, runs: int | None = None) -> np.ndarray:
     rng = np.random.default_rng(scenario.seed)
     noise = simulation.unit_noise(rng, scenario.n_steps, streams, runs=runs)
     return noise[..., [model.SENSORS.index("vision"), streams - 1]]
-
-
-def filter_model(scenario: Scenario, sigma_a: float, sigma_v: float,
-                 bias_prior_std: float = DEFAULT_BIAS_PRIOR_STD) -> dict[str, np.ndarray]:
-    """The model the filter of :func:`track_with_input` assumes, as keyword arguments.
-
-    ``A = F`` and ``B = G`` (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)),
-    ``C = [1, 0, 0]``, ``R = σ_v²``, ``z0 = [0, 0, 0]`` and
-    ``P0 = diag(A², (A·2πf)², bias_prior_std²)``: one amplitude A for position, the
-    path's peak speed for velocity. Pass them to
-    :func:`~lqe_helpers.filter.kalman_filter` with the measurements and the input u.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        Supplies Δt and the path's amplitude and frequency.
-    sigma_a : float
-        Noise σ_a of the acceleration signal in cm/s², > 0.
-    sigma_v : float
-        Vision noise σ_v in cm, > 0.
-    bias_prior_std : float
-        The prior standard deviation of the bias in cm/s², > 0.
-
-    Returns
-    -------
-    dict
-        ``A`` (3, 3), ``C`` (1, 3), ``Q`` (3, 3), ``R`` (1, 1), ``z0`` (3,), ``P0`` (3, 3)
-        and ``B`` (3, 1).
-    """
-    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
-    sigma_v = validation.positive("sigma_v", sigma_v, "cm")
-    bias_prior_std = validation.positive("bias_prior_std", bias_prior_std, "cm/s²")
-    dt = scenario.dt
-    return {
-        "A": transition_matrix(dt),
-        "C": model.observation_matrix(("vision",)),
-        "Q": process_noise_covariance(dt, sigma_a),
-        "R": model.measurement_noise_covariance([sigma_v]),
-        "z0": np.zeros(3),
-        "P0": np.diag([scenario.amplitude**2, scenario.peak_speed**2, bias_prior_std**2]),
-        "B": input_matrix(dt),
-    }
-
-
-@dataclass(frozen=True)
-class InputTracking:
-    """The hand tracked from vision plus a biased acceleration input.
-
-    Attributes
-    ----------
-    scenario : Scenario
-    bias, sigma_a, sigma_v : float
-        True bias (cm/s²), the signal's noise σ_a (cm/s²) and vision's σ_v (cm).
-    truth : ndarray, shape (n, 3)
-        True ``[p, v, b]``.
-    readings : ndarray, shape (..., n)
-        The acceleration signal u (cm/s²).
-    measurements : ndarray, shape (..., n, 1)
-        Vision's position readings (cm).
-    result : FilterResult
-        The filter's estimates ``[p̂, v̂, b̂]``, gains and covariances.
-    dead_reckoning : ndarray, shape (..., n, 3)
-        The signal integrated from the true start with no vision and b̂ = 0.
-    """
-
-    scenario: Scenario
-    bias: float
-    sigma_a: float
-    sigma_v: float
-    truth: np.ndarray
-    readings: np.ndarray
-    measurements: np.ndarray
-    result: FilterResult
-    dead_reckoning: np.ndarray
-
-    @property
-    def positions(self) -> np.ndarray:
-        """Filtered positions p̂ (cm), shape (..., n)."""
-        return self.result.estimates[..., 0]
-
-    @property
-    def bias_estimates(self) -> np.ndarray:
-        """Bias estimates b̂ (cm/s²), shape (..., n)."""
-        return self.result.estimates[..., 2]
-
-    @property
-    def bias_stds(self) -> np.ndarray:
-        """The filter's own standard deviation of b̂ (cm/s²), shape (..., n)."""
-        return np.sqrt(self.result.estimate_covariances[..., 2, 2])
-
-    @property
-    def position_stds(self) -> np.ndarray:
-        """The filter's own standard deviation of p̂ (cm), shape (..., n)."""
-        return np.sqrt(self.result.estimate_covariances[..., 0, 0])
-
-    def mse(self) -> np.ndarray:
-        """Per-run MSE (cm²) of the filtered position after the burn-in, shape (...)."""
-        return metrics.mse(self.positions, self.truth[:, 0], self.scenario.burn_in_steps)
-
-    def dead_reckoning_mse(self) -> np.ndarray:
-        """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
-        return metrics.mse(self.dead_reckoning[..., 0], self.truth[:, 0],
-                           self.scenario.burn_in_steps)
-
-
-def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
-                     sigma_a: float = DEFAULT_SIGMA_A, sigma_v: float | None = None,
-                     bias_prior_std: float = DEFAULT_BIAS_PRIOR_STD,
-                     runs: int | None = None, noise: np.ndarray | None = None
-                     ) -> InputTracking:
-    """Simulate vision and the biased signal, then filter with the signal as input.
-
-    The filter is :func:`~lqe_helpers.filter.kalman_filter` with ``A = F``, ``B = G``
-    (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)), ``C = [1, 0, 0]`` and
-    ``R = σ_v²`` (:func:`filter_model`). It starts from ``z0 = [0, 0, 0]`` with prior
-    standard deviations of one amplitude A for position, the path's peak speed A·2πf
-    for velocity and ``bias_prior_std`` for the bias: the observer knows the range of
-    the movement and roughly how large a bias can be, nothing more.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        The hand's path, Δt, seed and burn-in.
-    bias : float
-        True constant bias b of the signal in cm/s² (any sign).
-    sigma_a : float
-        True noise σ_a of the signal in cm/s², > 0; the filter's Q uses the same value.
-    sigma_v : float, optional
-        Vision noise σ_v in cm, > 0. Default: the scenario's.
-    bias_prior_std : float
-        The filter's prior standard deviation of the bias in cm/s², > 0.
-    runs : int, optional
-        Monte Carlo runs; None for the single run shown in figures (run 0).
-    noise : array_like, shape (n, 2) or (runs, n, 2), optional
-        Unit noise ``[vision, acceleration]``; default :func:`unit_noise`. Explorers
-        pass a draw they keep, so a slider never changes the noise pattern.
-
-    Returns
-    -------
-    InputTracking
-        Leading axis: runs, if any.
-    """
-    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
-    bias = validation.finite_number("bias", bias, "cm/s²")
-    sigma_a = validation.positive("sigma_a", sigma_a, "cm/s²")
-    sigma_v = validation.positive(
-        "sigma_v", scenario.sigma_v if sigma_v is None else sigma_v, "cm")
-    bias_prior_std = validation.positive("bias_prior_std", bias_prior_std, "cm/s²")
-    if noise is None:
-        noise = unit_noise(scenario, runs)
-    expected = (scenario.n_steps, 2) if runs is None else (runs, scenario.n_steps, 2)
-    noise = validation.shaped_array("noise", noise, expected, ", ".join(NOISE_COLUMNS))
-
-    dt = scenario.dt
-    truth = true_states(scenario, bias)
-    readings = acceleration_readings(step_accelerations(scenario), bias, sigma_a,
-                                     noise[..., 1])
-    measurements = simulation.measure(truth[:, 0], noise[..., :1], np.array([sigma_v]))
-    result = kalman_filter(measurements, **filter_model(scenario, sigma_a, sigma_v,
-                                                        bias_prior_std),
-                           u=readings[..., None])
-    drift = dead_reckoning(readings, initial_state(scenario, bias), dt)
-    return InputTracking(scenario, bias, sigma_a, sigma_v, truth, readings, measurements,
-                         result, drift)

@@ -90,6 +90,18 @@ def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,
     }
 
 
+def position_shares(gain: np.ndarray) -> np.ndarray:
+    """Each sensor's share of the position correction: the gain's position row, normalised.
+
+    ``gain`` (3, m) is a settled gain K∞. Its position row is ``P[0, 0] · (1/σ_i²)``
+    (K = P Cᵀ R⁻¹ with identical rows of C), so the shares are the reliability weights
+    (:func:`lqe_helpers.cue_combination.reliability_weights`,
+    ``tests/test_cue_combination.py``): here they come from the filter itself.
+    """
+    row = gain[0]
+    return row / row.sum()
+
+
 def trial_numbers(scenario: Scenario, sigma_v: float, sigma_p: float,
                   vision: experiments.Tracking, fused: experiments.Tracking) -> str:
     """Both σ's (cm) and the trial's MSEs (cm²) after the burn-in, as one sentence.

@@ -1,0 +1,237 @@
+"""Figures of notebook 00 (the background model): eyes closed, the choice of σ_j, Q's sweep."""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
+
+from ..plotting import COLORS, style
+from .common import errorbar_intervals, interval_arrays, label_axes, plot_series
+
+
+def open_loop_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
+                     estimate: np.ndarray, close: float, prediction_times: np.ndarray,
+                     prediction: np.ndarray, prediction_std: np.ndarray,
+                     start: float = 0.5, limit: float = 30.0) -> Figure:
+    """Tracking with vision until ``close``, then prediction with no measurements.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    truth, readings, estimate : array_like, shape (n,)
+        True position, visual readings and filtered position (cm); drawn up to
+        ``close`` (the truth up to the end of the prediction).
+    close : float
+        Time (s) at which the eyes close, marked by a dotted vertical line.
+    prediction_times : array_like, shape (h,)
+        Times (s) of the prediction, from ``close`` on.
+    prediction, prediction_std : array_like, shape (h,)
+        Predicted position and its standard deviation (cm), drawn with a ±2σ band.
+    start : float
+        First time shown (s).
+    limit : float
+        The position axis runs from −limit to +limit (cm), > 0.
+
+    Returns
+    -------
+    Figure
+        One panel; lines in the order readings, truth, estimate, prediction.
+    """
+    times = np.asarray(times, dtype=float)
+    prediction_times = np.asarray(prediction_times, dtype=float)
+    prediction = np.asarray(prediction, dtype=float)
+    prediction_std = np.asarray(prediction_std, dtype=float)
+    if limit <= 0:
+        raise ValueError(f"limit must be > 0 cm, got {limit}")
+    end = float(prediction_times[-1])
+    seen = times <= close
+    shown = times <= end
+    fig, ax = plt.subplots(figsize=(10, 4.5))
+    plot_series(ax, times, [(readings, "vision", "vision")], seen)
+    plot_series(ax, times, [(truth, "truth", "true path")], shown)
+    plot_series(ax, times, [(estimate, "estimate", "filtered estimate")], seen)
+    ax.plot(prediction_times, prediction,
+            **style("prediction", label="prediction with eyes closed"))
+    ax.fill_between(prediction_times, prediction - 2 * prediction_std,
+                    prediction + 2 * prediction_std, color=COLORS["prediction"], alpha=0.15,
+                    linewidth=0, label="±2σ of the prediction")
+    ax.axvline(close, color=COLORS["truth"], linewidth=0.8, linestyle=":")
+    label_axes(ax, "time (s)", "position (cm)",
+               f"Eyes closed at t = {close:g} s: the model extrapolates, its uncertainty "
+               "fans out", xlim=(start, end), ylim=(-limit, limit),
+               legend={"loc": "lower left", "ncols": 3, "markerscale": 3, "fontsize": 9})
+    fig.tight_layout()
+    return fig
+
+
+def mse_intervals_figure(labels: list[str], intervals, xlabel: str = "MSE (cm²)",
+                         title: str = "", reference: float | None = None,
+                         reference_label: str = "") -> Figure:
+    """Monte Carlo means with their 95 % intervals, one row per condition.
+
+    Parameters
+    ----------
+    labels : list of str
+        Name of each condition, top to bottom.
+    intervals : sequence of metrics.Interval
+        Mean and 95 % interval of each condition (e.g. MSE in cm²).
+    xlabel : str
+        Quantity and unit of the values.
+    title : str
+        Title (say what was compared).
+    reference : float, optional
+        A value drawn as a dashed vertical line (e.g. raw vision's MSE σ_v²).
+    reference_label : str
+        Legend label of the reference line.
+
+    Returns
+    -------
+    Figure
+        One panel; its first line holds the means (x) against the rows (y = 0, 1, …
+        from the top).
+    """
+    mean, low, high = interval_arrays(intervals)
+    if len(labels) != mean.size:
+        raise ValueError(f"labels must name each of the {mean.size} intervals, got "
+                         f"{len(labels)} labels")
+    rows = np.arange(mean.size)
+    fig, ax = plt.subplots(figsize=(8, 1.2 + 0.6 * mean.size))
+    ax.errorbar(mean, rows, xerr=[mean - low, high - mean], capsize=4, marker="o",
+                **style("estimate", linestyle="none", label="Monte Carlo mean, 95 % CI"))
+    if reference is not None:
+        ax.axvline(reference, **style("reference", linestyle="--", label=reference_label))
+    ax.set_yticks(rows, labels)
+    label_axes(ax, xlabel, title=title, ylim=(mean.size - 0.5, -0.5),
+               legend={"loc": "lower right", "fontsize": 8})
+    fig.tight_layout()
+    return fig
+
+
+def uncertainty_growth_figure(elapsed: np.ndarray,
+                              curves: dict[str, tuple[np.ndarray, str, float]],
+                              amplitude: float | None = None) -> Figure:
+    """Twice the predicted position's σ against time with no measurements, log–log.
+
+    Parameters
+    ----------
+    elapsed : array_like, shape (n,)
+        Time since the last measurement (s), > 0.
+    curves : dict
+        Label → (2σ of the predicted position (cm), shape (n,); line style such as
+        ``"-"`` or ``":"``; line width). All are predictions, drawn in the prediction
+        colour and told apart by line style.
+    amplitude : float, optional
+        The flight's amplitude (cm), drawn as a horizontal line.
+
+    Returns
+    -------
+    Figure
+        One panel with log axes; the curves are its first lines, in the order given.
+    """
+    elapsed = np.asarray(elapsed, dtype=float)
+    if np.any(elapsed <= 0):
+        raise ValueError("elapsed must be > 0 s everywhere (log axis), got a value <= 0")
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    for label, (curve, linestyle, width) in curves.items():
+        ax.plot(elapsed, np.asarray(curve, dtype=float),
+                **style("prediction", linestyle=linestyle, linewidth=width, label=label))
+    if amplitude is not None:
+        ax.axhline(amplitude, **style("reference", linestyle="-", linewidth=0.9,
+                                      label="flight amplitude"))
+    label_axes(ax, "time without measurements (s)", "2σ of predicted position (cm)",
+               "Position uncertainty with no measurements", xscale="log", yscale="log",
+               legend={"loc": "upper left", "fontsize": 8})
+    fig.tight_layout()
+    return fig
+
+
+def jerk_sweep_figure(jerk_stds: np.ndarray, intervals, systematic: np.ndarray,
+                      noise: np.ndarray, expected: np.ndarray, raw_mse: float,
+                      derived: float) -> Figure:
+    """Tracking error against the jerk noise σ_j behind Q, split into its two parts.
+
+    Parameters
+    ----------
+    jerk_stds : array_like, shape (s,)
+        The σ_j tried (cm/s³), > 0.
+    intervals : sequence of metrics.Interval, length s
+        Monte Carlo MSE of the filtered position at each σ_j (cm²).
+    systematic, noise : array_like, shape (s,)
+        The MSE's systematic part (noise-free run) and noise part (cm²).
+    expected : array_like, shape (s,)
+        The filter's own steady-state position variance (cm²).
+    raw_mse : float
+        MSE of the raw readings, σ_v² (cm²).
+    derived : float
+        The σ_j the pack derives from the motion (cm/s³), marked by a vertical line.
+
+    Returns
+    -------
+    Figure
+        One log–log panel; lines in the order MSE, systematic, noise, expected.
+    """
+    jerk_stds = np.asarray(jerk_stds, dtype=float)
+    fig, ax = plt.subplots(figsize=(10, 5))
+    errorbar_intervals(ax, jerk_stds, intervals, "estimate", marker="o",
+                       **style("estimate", label="MSE of the filtered position (95 % CI)"))
+    ax.plot(jerk_stds, np.asarray(systematic, dtype=float),
+            **style("estimate", linestyle="--", linewidth=1.2,
+                    label="systematic part (noise-free run)"))
+    ax.plot(jerk_stds, np.asarray(noise, dtype=float),
+            **style("estimate", linestyle=":", linewidth=1.6, label="noise part"))
+    ax.plot(jerk_stds, np.asarray(expected, dtype=float),
+            **style("reference", linestyle="-", linewidth=1.4, marker="s", markersize=4,
+                    markerfacecolor="none", label="the filter's own expected variance"))
+    ax.axhline(raw_mse, color=COLORS["vision"], linestyle="-.", linewidth=1.4,
+               label="raw vision, σ_v²")
+    ax.axvline(derived, color=COLORS["truth"], linewidth=0.8, linestyle="-",
+               label=f"derived σ_j = {derived:,.0f} cm/s³")
+    label_axes(ax, "jerk noise σ_j behind Q (cm/s³)", "position error (cm²)",
+               "Tracking error against the process noise", xscale="log", yscale="log",
+               legend={"loc": "lower left", "fontsize": 8, "ncols": 2})
+    fig.tight_layout()
+    return fig
+
+
+def tracking_panels_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
+                           panels: dict[str, np.ndarray],
+                           window: tuple[float, float]) -> Figure:
+    """The same readings filtered several ways, one panel per filter, over a window.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    truth, readings : array_like, shape (n,)
+        True position and visual readings (cm), the same in every panel.
+    panels : dict
+        Panel title → filtered position (cm), shape (n,).
+    window : tuple of float
+        (start, end) of the time shown (s).
+
+    Returns
+    -------
+    Figure
+        One panel per entry, sharing the position axis; in each the lines are readings,
+        truth, estimate.
+    """
+    times = np.asarray(times, dtype=float)
+    if not panels:
+        raise ValueError("panels must hold at least one filter, got none")
+    start, end = window
+    if not end > start:
+        raise ValueError(f"window must be (start, end) with end > start, got {window}")
+    shown = (times >= start) & (times <= end)
+    fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 4), sharey=True,
+                             squeeze=False)
+    for ax, (title, estimate) in zip(axes[0], panels.items(), strict=True):
+        plot_series(ax, times, [(readings, "vision", "vision"), (truth, "truth", "true path"),
+                                (estimate, "estimate", "filtered estimate")], shown)
+        ax.set_title(title, fontsize=9)
+        label_axes(ax, "time (s)", xlim=(start, end))
+    label_axes(axes[0, 0], ylabel="position (cm)",
+               legend={"loc": "lower left", "fontsize": 8, "markerscale": 3})
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,242 @@
+"""What several notebooks' figures share: two figures, and the pieces every figure is made of.
+
+The figures: :func:`tracking_comparison_figure` (estimates beside the truth, their errors
+below; notebooks 01, 03, 04, 05) and :func:`paired_mse_figure` (one point per Monte
+Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
+(:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
+means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
+:func:`mean_band`), values marked by a labelled vertical line (:func:`mark_values`),
+plain tick labels on a log axis (:func:`plain_log_ticks`) and the first seconds of a
+trial (:func:`first_seconds`). Nothing runs on import.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping, Sequence
+
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
+
+from ..plotting import COLORS, style
+
+#: A series to draw: (values, shape (n,); style role; legend label or None).
+Series = tuple[np.ndarray, str, "str | None"]
+
+
+def interval_arrays(intervals: Iterable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Means, lower and upper ends of a sequence of ``metrics.Interval`` (or alike), (s,) each.
+
+    Raises
+    ------
+    ValueError
+        If ``intervals`` is empty.
+    """
+    intervals = list(intervals)
+    if not intervals:
+        raise ValueError("intervals must hold at least one interval, got none")
+    return (np.array([float(iv.mean) for iv in intervals]),
+            np.array([float(iv.low) for iv in intervals]),
+            np.array([float(iv.high) for iv in intervals]))
+
+
+def first_seconds(times: np.ndarray, until: float) -> tuple[np.ndarray, np.ndarray]:
+    """``times`` (s) as floats and the mask of the samples up to ``until`` (s, > 0).
+
+    Raises
+    ------
+    ValueError
+        If ``until`` is not > 0.
+    """
+    times = np.asarray(times, dtype=float)
+    if until <= 0:
+        raise ValueError(f"until must be > 0 s, got {until}")
+    return times, times <= until
+
+
+def plot_series(ax: Axes, times: np.ndarray, series: Iterable[Series],
+                shown: np.ndarray | None = None, **line: object) -> None:
+    """Draw each (values, role, label) of ``series`` against ``times``, in its role's style.
+
+    ``shown`` (a mask or index of the samples) restricts every series to those samples;
+    ``line`` overrides the roles' styles for every series (e.g. ``linewidth=1.1``).
+    """
+    times = np.asarray(times, dtype=float)
+    selected = slice(None) if shown is None else shown
+    for values, role, label in series:
+        ax.plot(times[selected], np.asarray(values, dtype=float)[selected],
+                **style(role, label=label, **line))
+
+
+def label_axes(ax: Axes, xlabel: str | None = None, ylabel: str | None = None,
+               title: str | None = None, *, xscale: str | None = None,
+               yscale: str | None = None, xlim: tuple | None = None,
+               ylim: tuple | None = None,
+               legend: Mapping[str, object] | None = None) -> None:
+    """Decorate ``ax`` in one call: scales, then limits, labels, title and legend.
+
+    Parameters
+    ----------
+    ax : matplotlib.axes.Axes
+        The axes.
+    xlabel, ylabel : str, optional
+        Quantity and unit of each axis, e.g. ``"time (s)"``.
+    title : str, optional
+        What the panel shows.
+    xscale, yscale : str, optional
+        ``"log"`` for a logarithmic axis.
+    xlim, ylim : tuple, optional
+        Axis limits, (low, high).
+    legend : mapping, optional
+        Keyword arguments of :meth:`~matplotlib.axes.Axes.legend` (e.g. ``{"loc":
+        "upper right", "fontsize": 8}``); None draws no legend.
+    """
+    if xscale is not None:
+        ax.set_xscale(xscale)
+    if yscale is not None:
+        ax.set_yscale(yscale)
+    if xlim is not None:
+        ax.set_xlim(*xlim)
+    if ylim is not None:
+        ax.set_ylim(*ylim)
+    if xlabel is not None:
+        ax.set_xlabel(xlabel)
+    if ylabel is not None:
+        ax.set_ylabel(ylabel)
+    if title is not None:
+        ax.set_title(title)
+    if legend is not None:
+        ax.legend(**legend)
+
+
+def errorbar_intervals(ax: Axes, x: np.ndarray, intervals: Iterable, role: str,
+                       **line: object) -> None:
+    """Means of ``intervals`` against ``x`` with their 95 % intervals as error bars.
+
+    Drawn in the role's colour with markers of size 4 and caps of 2 points; ``line``
+    adds or overrides keyword arguments of :meth:`~matplotlib.axes.Axes.errorbar`.
+    """
+    mean, low, high = interval_arrays(intervals)
+    ax.errorbar(x, mean, yerr=[mean - low, high - mean],
+                **{"color": COLORS[role], "markersize": 4, "capsize": 2, **line})
+
+
+def mean_band(ax: Axes, x: np.ndarray, intervals: Iterable, role: str, label: str,
+              **line: object) -> np.ndarray:
+    """Plot the means of ``intervals`` against ``x`` over their shaded 95 % band; the means."""
+    mean, low, high = interval_arrays(intervals)
+    ax.fill_between(x, low, high, color=COLORS[role], alpha=0.25, linewidth=0)
+    ax.plot(x, mean, **style(role, label=label, **line))
+    return mean
+
+
+def mark_values(ax: Axes, marks: Mapping[str, float], color: str, **line: object) -> None:
+    """A vertical line at each value of ``marks``, labelled with its key at the top left.
+
+    ``line`` styles the lines (e.g. ``linewidth=1``); the labels share their colour.
+    """
+    for text, value in marks.items():
+        ax.axvline(value, color=color, **line)
+        ax.annotate(text, (value, 1.0), xycoords=("data", "axes fraction"), xytext=(3, -12),
+                    textcoords="offset points", color=color, fontsize=9)
+
+
+def plain_log_ticks(ax: Axes, axis: str, ticks: Sequence[float] | None) -> None:
+    """Put ``ticks`` on a log ``axis`` ("x" or "y") labelled as plain numbers (0.3, not 3e-1).
+
+    None leaves the axis as it is.
+    """
+    if ticks is None:
+        return
+    ticks = list(ticks)
+    labels = [f"{tick:g}" for tick in ticks]
+    if axis == "x":
+        ax.set_xticks(ticks, labels)
+    else:
+        ax.set_yticks(ticks, labels)
+        ax.yaxis.set_minor_locator(plt.NullLocator())
+
+
+def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
+                               estimates: dict[str, tuple[np.ndarray, str]],
+                               readings: dict[str, tuple[np.ndarray, str]] | None = None,
+                               title: str = "") -> Figure:
+    """Estimates beside the truth (top) and their errors (bottom), for one trial.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    truth : array_like, shape (n,)
+        True position (cm).
+    estimates : dict
+        Label → (estimated positions (cm), shape (n,); style role such as ``"estimate"``
+        or ``"alternative"``). Each is drawn on top and its error (estimate − truth) below.
+    readings : dict, optional
+        Label → (sensor readings (cm), shape (n,); role ``"vision"`` or
+        ``"proprioception"``), drawn on top only.
+    title : str
+        Title of the top panel (say what changed, e.g. "σ_v = σ_p = 1.5 cm").
+
+    Returns
+    -------
+    Figure
+        Two panels sharing the time axis; lines in the order readings, truth, estimates.
+    """
+    times = np.asarray(times, dtype=float)
+    truth = np.asarray(truth, dtype=float)
+    fig, (ax_top, ax_err) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True,
+                                         gridspec_kw={"height_ratios": [1.5, 1]})
+    plot_series(ax_top, times, [(values, role, label)
+                                for label, (values, role) in (readings or {}).items()])
+    ax_top.plot(times, truth, **style("truth", label="true position"))
+    ax_err.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
+    for label, (values, role) in estimates.items():
+        values = np.asarray(values, dtype=float)
+        ax_top.plot(times, values, **style(role, label=label))
+        ax_err.plot(times, values - truth, **style(role, linewidth=1.1, label=label))
+    label_axes(ax_top, ylabel="position (cm)", title=title,
+               legend={"loc": "upper right", "fontsize": 9, "ncol": 2, "markerscale": 2.5})
+    label_axes(ax_err, "time (s)", "error (cm)", xlim=(times[0], times[-1]))
+    fig.tight_layout()
+    return fig
+
+
+def paired_mse_figure(mse_first: np.ndarray, mse_second: np.ndarray, label_first: str,
+                      label_second: str, title: str = "") -> Figure:
+    """One point per Monte Carlo run: its MSE in one condition against the other.
+
+    Points below the diagonal are runs in which the second condition had the smaller
+    error. Run r of both conditions must come from the same noise (paired runs).
+
+    Parameters
+    ----------
+    mse_first, mse_second : array_like, shape (runs,)
+        Per-run MSEs (cm²) of the two conditions.
+    label_first, label_second : str
+        Names of the conditions (x and y axis).
+    title : str
+        Title (say what was compared).
+
+    Returns
+    -------
+    Figure
+        The first line holds the runs, the second the diagonal "no change".
+    """
+    first = np.asarray(mse_first, dtype=float)
+    second = np.asarray(mse_second, dtype=float)
+    if first.shape != second.shape or first.ndim != 1:
+        raise ValueError(f"mse_first and mse_second must be paired vectors (runs,), got "
+                         f"shapes {first.shape} and {second.shape}")
+    fig, ax = plt.subplots(figsize=(5.6, 5.2))
+    ax.plot(first, second, linestyle="none", marker="o", markersize=3.5, alpha=0.5,
+            color=COLORS["estimate"], label=f"one Monte Carlo run ({first.size} in all)")
+    top = 1.1 * float(max(first.max(), second.max()))
+    ax.plot([0.0, top], [0.0, top], **style("truth", linewidth=1, label="no change (diagonal)"))
+    ax.plot([first.mean()], [second.mean()], linestyle="none", marker="D", markersize=8,
+            markeredgecolor="black", color=COLORS["prediction"], label="Monte Carlo mean")
+    ax.set_aspect("equal")
+    label_axes(ax, f"MSE, {label_first} (cm²)", f"MSE, {label_second} (cm²)", title,
+               xlim=(0.0, top), ylim=(0.0, top), legend={"loc": "upper left", "fontsize": 9})
+    return fig
