@@ -215,6 +215,9 @@ def _sensor_sigmas(name: str, sigmas: object, sensors: tuple[str, ...]) -> np.nd
             f"{name} must have one σ per sensor {sensors} on its last axis, "
             f"got shape {sigmas.shape}"
         )
+    validation.in_float_range(
+        f"{name} (largest {np.max(sigmas):g} cm, smallest {np.min(sigmas):g} cm)",
+        lambda: sigmas**2, positive=True)
     return sigmas
 
 

@@ -30,7 +30,7 @@ def transition_matrix(dt: float) -> np.ndarray:
         acceleration·Δt²/2, velocity gains acceleration·Δt, acceleration is kept.
     """
     dt = validation.positive("dt", dt, "s")
-    return _in_range(f"dt = {dt:g} s", lambda: np.array(
+    return validation.in_float_range(f"dt = {dt:g} s", lambda: np.array(
         [[1.0, dt, dt * dt / 2.0], [0.0, 1.0, dt], [0.0, 0.0, 1.0]]))
 
 
@@ -52,7 +52,8 @@ def jerk_input_matrix(dt: float) -> np.ndarray:
         ``[[Δt³/6], [Δt²/2], [Δt]]`` in s³, s², s.
     """
     dt = validation.positive("dt", dt, "s")
-    return _in_range(f"dt = {dt:g} s", lambda: np.array([[dt**3 / 6.0], [dt**2 / 2.0], [dt]]))
+    return validation.in_float_range(
+        f"dt = {dt:g} s", lambda: np.array([[dt**3 / 6.0], [dt**2 / 2.0], [dt]]))
 
 
 def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
@@ -80,8 +81,9 @@ def process_noise_covariance(dt: float, jerk_std: float) -> np.ndarray:
     """
     jerk_std = validation.non_negative("jerk_std", jerk_std, "cm/s³")
     dt = validation.positive("dt", dt, "s")
-    return _in_range(f"jerk_std = {jerk_std:g} cm/s³ with dt = {dt:g} s",
-                     lambda: _matrices.input_noise_covariance(jerk_input_matrix(dt), jerk_std))
+    return validation.in_float_range(
+        f"jerk_std = {jerk_std:g} cm/s³ with dt = {dt:g} s",
+        lambda: _matrices.input_noise_covariance(jerk_input_matrix(dt), jerk_std))
 
 
 def observation_matrix(sensors: Sequence[str] = ("vision",)) -> np.ndarray:
@@ -117,8 +119,9 @@ def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.nda
     sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
     if np.any(sigmas <= 0):
         raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
-    _in_range(f"sigmas (largest {np.max(sigmas):g} cm, smallest {np.min(sigmas):g} cm)",
-              lambda: sigmas**2, positive=True)
+    validation.in_float_range(
+        f"sigmas (largest {np.max(sigmas):g} cm, smallest {np.min(sigmas):g} cm)",
+        lambda: sigmas**2, positive=True)
     return _matrices.noise_covariance(sigmas)
 
 
@@ -147,18 +150,6 @@ def diagonal_covariance(variance: float | np.ndarray, size: int = 3) -> np.ndarr
                             (variance.size + 1) * size * size, what="for the covariances")
     return _matrices.scaled_identity(variance, size)
 
-
-def _in_range(inputs: str, compute, positive: bool = False) -> np.ndarray:
-    """``compute()``, or a ``ValueError`` naming ``inputs`` if it leaves the float64 range."""
-    try:
-        with np.errstate(over="ignore", under="ignore"):
-            result = np.asarray(compute())
-    except OverflowError:  # Python's float power raises instead of returning inf
-        result = np.array(np.inf)
-    if not np.all(np.isfinite(result)) or (positive and np.any(result == 0)):
-        raise ValueError(f"{inputs} give numbers beyond the float64 range (squares or cubes "
-                         f"overflow to inf or underflow to 0)")
-    return result
 
 
 def sensor_names(sensors: Sequence[str]) -> tuple[str, ...]:

@@ -387,3 +387,22 @@ def broadcast_batches(**shapes: tuple[int, ...]) -> tuple[int, ...]:
         raise ValueError(
             f"leading batch axes must broadcast against each other, got {listed}"
         ) from None
+
+
+def in_float_range(inputs: str, compute: Callable[[], object],
+                   positive: bool = False) -> np.ndarray:
+    """``compute()`` as an array, or a ``ValueError`` naming ``inputs`` if it leaves float64.
+
+    ``inputs`` describes the values behind the computation for the message (e.g.
+    ``"sigmas (largest 1e+200 cm, smallest 1 cm)"``). With ``positive``, a result that
+    underflows to 0 is refused too (a variance that must stay > 0).
+    """
+    try:
+        with np.errstate(over="ignore", under="ignore"):
+            result = np.asarray(compute())
+    except OverflowError:  # Python's float power raises instead of returning inf
+        result = np.array(np.inf)
+    if not np.all(np.isfinite(result)) or (positive and np.any(result == 0)):
+        raise ValueError(f"{inputs} give numbers beyond the float64 range (squares or cubes "
+                         f"overflow to inf or underflow to 0)")
+    return result
