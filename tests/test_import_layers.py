@@ -7,7 +7,7 @@ Layers, bottom to top (issue 18):
 * drawing: ``plotting`` and ``figures`` (figures take arrays, so they import no
   experiment and no explorer);
 * experiments: ``experiments`` and ``bias_model``, whose results may draw themselves
-  through ``figures``;
+  through ``figures``, and ``jerk_tuning``, which runs experiments;
 * explorers and checks, side by side: neither imports the other;
 * authoring: the instructor's tools, which nothing imports.
 
@@ -45,7 +45,7 @@ def layer_of(module: str) -> str:
     top = parts[0] if parts else ""
     if top in ("plotting", "figures"):
         return "drawing"
-    if top in ("experiments", "bias_model"):
+    if top in ("experiments", "bias_model", "jerk_tuning"):
         return "experiments"
     if top in ("explorers", "checks", "authoring"):
         return top
