@@ -126,6 +126,17 @@ class Tracking:
         return metrics.mse(self.positions, self.scenario.truth[:, 0],
                            self.scenario.burn_in_steps)
 
+    def innovations(self) -> metrics.Innovations:
+        """Each reading minus the filter's prediction of it, with its covariance S_j.
+
+        What an observer can check without the true path
+        (:func:`~lqe_helpers.metrics.innovations`; :func:`~lqe_helpers.metrics.nis_test`
+        of the result says whether the filter's model is consistent with its readings).
+        Values (..., n, m) in cm, covariances (..., n, m, m) in cm².
+        """
+        return metrics.innovations(self.measurements, self.result, self.model.A,
+                                   self.model.C, self.model.z0)
+
     def measurement_mse(self, sensor: str = "vision") -> np.ndarray:
         """Per-run MSE (cm²) of one sensor's raw readings after the burn-in, shape (...)."""
         if not isinstance(sensor, str) or sensor not in self.sensors:

@@ -288,3 +288,18 @@ def test_result_figures_refuse_what_they_cannot_draw() -> None:
         experiments.delay_and_compensate(experiments.track(DEFAULT), 0.0).figure()
     with pytest.raises(ValueError, match="run must pick one run"):
         experiments.delay_and_compensate(batch, 0.1).figure()
+
+
+def test_innovations_are_each_reading_minus_the_filters_prediction_of_it() -> None:
+    """Against a hand loop: e_j = y_j − C A ẑ_{j−1} (ẑ_{−1} = z0), S_j = C P_j Cᵀ + R."""
+    scenario = dataclasses.replace(DEFAULT, duration=0.5)
+    tracking = experiments.track(scenario, ("vision", "proprioception"), sigmas=[1.5, 4.5])
+    innovations = tracking.innovations()
+    fm = tracking.model
+    previous = fm.z0
+    for j, y_j in enumerate(tracking.measurements):
+        expected = y_j - fm.C @ fm.A @ previous
+        np.testing.assert_allclose(innovations.values[j], expected, rtol=0, atol=1e-12)
+        previous = tracking.result.estimates[j]
+    np.testing.assert_allclose(innovations.covariances[0], fm.C @ fm.P0 @ fm.C.T + fm.R,
+                               rtol=1e-12)
