@@ -292,7 +292,7 @@ def test_result_figures_refuse_what_they_cannot_draw() -> None:
 
 def test_innovations_are_each_reading_minus_the_filters_prediction_of_it() -> None:
     """Against a hand loop: e_j = y_j − C A ẑ_{j−1} (ẑ_{−1} = z0), S_j = C P_j Cᵀ + R."""
-    scenario = dataclasses.replace(DEFAULT, duration=0.5)
+    scenario = dataclasses.replace(DEFAULT, duration=0.5, burn_in=0.1)
     tracking = experiments.track(scenario, ("vision", "proprioception"), sigmas=[1.5, 4.5])
     innovations = tracking.innovations()
     fm = tracking.model
