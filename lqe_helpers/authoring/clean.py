@@ -13,17 +13,13 @@ import argparse
 from collections.abc import Sequence
 from pathlib import Path
 
-from lqe_helpers.authoring.files import (
-    MANIFEST_NAME,
-    CommandLineParser,
-    read_manifest,
-    remove_output_folder,
-    run_command,
-)
+from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+from lqe_helpers.authoring.manifest import MANIFEST_NAME, read_manifest
+from lqe_helpers.authoring.output_folder import remove_output_folder
 
 
 def clean(folders: Sequence[Path | str]) -> list[str]:
-    """Clean each output folder (:func:`~lqe_helpers.authoring.files.remove_output_folder`).
+    """Clean each output folder (:func:`~lqe_helpers.authoring.output_folder.remove_output_folder`).
 
     Returns
     -------

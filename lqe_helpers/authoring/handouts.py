@@ -14,7 +14,7 @@ error output, or displays a widget with no static view (which a page could only 
 as a placeholder) stops the build, and the message names the notebook and the cell
 (and gives the traceback); output on stderr (a warning) is reported but kept. A cell
 may run ``--timeout`` seconds (default 300). Only once every page is ready is anything
-written, all together or not at all (:mod:`lqe_helpers.authoring.files`): the folder's
+written, all together or not at all (:mod:`lqe_helpers.authoring.output_folder`): the folder's
 manifest ``.lqe-manifest.json`` lists what the build wrote, so the next build replaces or
 deletes only those files (the page of a notebook since renamed goes) and only while they
 are unchanged. Any other file there (an instructor's ``course_home.html``) is never
@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -46,20 +45,13 @@ from pathlib import Path
 from urllib.parse import quote
 
 import nbformat
-from nbconvert.exporters import HTMLExporter
 from nbconvert.filters import strip_ansi
-from nbconvert.preprocessors import Preprocessor
-from traitlets import List, Unicode
 
 from lqe_helpers.authoring import handout_pages
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    ToolError,
-    plan_output_folder,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
+from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+from lqe_helpers.authoring.errors import ToolError
+from lqe_helpers.authoring.handout_pages import handout_exporter
+from lqe_helpers.authoring.notebook_io import source_notebooks
 from lqe_helpers.authoring.notebook_runner import (
     CELL_TIMEOUT,
     WIDGET_VIEW_MIMETYPE,
@@ -67,6 +59,7 @@ from lqe_helpers.authoring.notebook_runner import (
     execute_notebook,
     positive_seconds,
 )
+from lqe_helpers.authoring.output_folder import plan_output_folder, write_output_folder
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"
@@ -89,35 +82,6 @@ class HandoutBuildError(ToolError, RuntimeError):
 
 class HandoutWarning(UserWarning):
     """A handout page will show something a reader should not need (a warning)."""
-
-
-class NotebookLinkPreprocessor(Preprocessor):
-    """Point markdown links to another notebook of the pack at that notebook's page.
-
-    ``[see question (c)](03_fusion.ipynb#The-question)`` becomes a link to
-    ``03_fusion.html#The-question``, in markdown and in raw ``href`` attributes. Only
-    the notebooks named in ``stems`` are rewritten; any other link is left alone.
-    """
-
-    stems = List(Unicode(), help="File stems of the notebooks that have a page.").tag(
-        config=True)
-
-    _LINK = re.compile(
-        r"""(?P<before>\]\(\s*<?|href\s*=\s*["'])(?:\./)?(?P<stem>[\w.-]+)\.ipynb"""
-        r"""(?=[#)>"'\s])"""
-    )
-
-    def preprocess_cell(self, cell: nbformat.NotebookNode, resources: dict,
-                        index: int) -> tuple[nbformat.NotebookNode, dict]:
-        """Rewrite the links of a markdown cell."""
-        if cell.cell_type == "markdown" and ".ipynb" in cell.source:
-            stems = set(self.stems)
-            cell.source = self._LINK.sub(
-                lambda match: (f"{match['before']}{match['stem']}.html"
-                               if match["stem"] in stems else match[0]),
-                cell.source,
-            )
-        return cell, resources
 
 
 @dataclass(frozen=True)
@@ -202,27 +166,6 @@ def stderr_outputs(notebook: nbformat.NotebookNode) -> list[str]:
     ]
 
 
-def handout_exporter(*, code: bool = True, mathjax_url: str = "",
-                     stems: Sequence[str] = ()) -> HTMLExporter:
-    """The HTML exporter for handout pages (:func:`handout_pages.handout_exporter`).
-
-    Parameters
-    ----------
-    code : bool
-        Show the code cells' source (``False`` for the prose variant: markdown,
-        printed results and figures only, without prompts).
-    mathjax_url : str
-        URL that loads MathJax as the page sees it
-        (:func:`handout_pages.mathjax_url` for the local copy); ``""`` leaves it out.
-    stems : sequence of str
-        File stems of the notebooks that get a page next to this one; markdown links
-        to ``<stem>.ipynb`` are pointed at ``<stem>.html``.
-    """
-    return handout_pages.handout_exporter(
-        code=code, mathjax_url=mathjax_url,
-        preprocessors=[NotebookLinkPreprocessor(stems=list(stems))])
-
-
 def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNode:
     """A one-cell notebook whose markdown lists ``pages`` in order (the index page)."""
     if code:
@@ -294,7 +237,7 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
 
     The output folder is checked before any notebook runs, and written only once every
-    page is ready, all together (:func:`~lqe_helpers.authoring.files.write_output_folder`):
+    page is ready, all together (:func:`~lqe_helpers.authoring.output_folder.write_output_folder`):
     any failure leaves it as it was. The build records what it wrote in the folder's
     manifest (``.lqe-manifest.json``); a rebuild replaces or deletes only those files,
     and only while they are unchanged. Every other file in the folder (an instructor's

@@ -18,7 +18,7 @@ writes one Markdown file, ``marking-guide.md``. For each notebook, in order:
 
 Nothing is executed: the notebooks' saved outputs are read (nbval proves they are what
 a fresh run prints). The source notebooks are only read. The file is written through
-:mod:`lqe_helpers.authoring.files` (atomically, into a folder the tool owns).
+:mod:`lqe_helpers.authoring.output_folder` (atomically, into a folder the tool owns).
 """
 
 from __future__ import annotations
@@ -32,20 +32,17 @@ from pathlib import Path
 
 import nbformat
 
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    read_notebook,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
-from lqe_helpers.authoring.student_edition import (
+from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+from lqe_helpers.authoring.output_folder import write_output_folder
+from lqe_helpers.authoring.task_cells import (
     ANSWER_TAG,
     CHECK_CALL,
     GOING_FURTHER,
     SOLUTION_TAG,
     answer_headings,
     cell_place,
+    cell_tags,
     task_instruction,
 )
 
@@ -225,10 +222,6 @@ def output_blocks(cell: nbformat.NotebookNode, where: str) -> list[str]:
     return blocks
 
 
-def _tags(cell: nbformat.NotebookNode) -> list[str]:
-    return list(cell.get("metadata", {}).get("tags", []))
-
-
 def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     """What the guide says about one worked notebook (see the module docstring).
 
@@ -246,7 +239,7 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     items: list[Task | Answer] = []
     core = True
     for index, cell in enumerate(cells):
-        tags = _tags(cell)
+        tags = cell_tags(cell)
         where = cell_place(name, index, cell)
         if cell.cell_type == "markdown" and cell.source.lstrip().startswith(GOING_FURTHER):
             core = False
@@ -255,7 +248,7 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
                                    for line in task_instruction(cell.source))
             after = cells[index + 1] if index + 1 < len(cells) else None
             check = (after.source.strip() if after is not None and after.cell_type == "code"
-                     and CHECK_CALL in after.source and not _tags(after) else None)
+                     and CHECK_CALL in after.source and not cell_tags(after) else None)
             printed = "".join(output.get("text", "") for output in after.get("outputs", [])
                               ).strip() if check else ""
             items.append(Task(where, instruction, core, check,
@@ -344,7 +337,7 @@ def build_marking_guide(source_dir: Path, out_dir: Path) -> Path:
         Folder of the worked, executed notebooks (read only).
     out_dir : Path
         Folder for the guide (created if needed; the tool replaces only what it wrote
-        there, see :func:`lqe_helpers.authoring.files.write_output_folder`).
+        there, see :func:`lqe_helpers.authoring.output_folder.write_output_folder`).
 
     Returns
     -------

@@ -23,18 +23,10 @@ import nbformat
 from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    NotebookFileError,
-    ToolError,
-    atomic_write_many,
-    fail,
-    notebook_bytes,
-    read_notebook,
-    refuse_symlink,
-    run_command,
-    strip_colour,
-)
+from lqe_helpers.authoring.command_line import CommandLineParser, fail, run_command
+from lqe_helpers.authoring.errors import NotebookFileError, ToolError, strip_colour
+from lqe_helpers.authoring.files import atomic_write_many, refuse_symlink
+from lqe_helpers.authoring.notebook_io import notebook_bytes, read_notebook
 
 __all__ = ["CELL_TIMEOUT", "WIDGET_VIEW_MIMETYPE", "NotebookRunError", "execute_notebook",
            "fail", "main", "positive_seconds", "run_notebooks"]

@@ -26,7 +26,7 @@
 
 The marking guide is never in the pack. The zip is the same, byte for byte, for the same
 sources (fixed file times and order), and is written atomically into a folder the tool
-owns (:func:`lqe_helpers.authoring.files.write_output_folder`).
+owns (:func:`lqe_helpers.authoring.output_folder.write_output_folder`).
 """
 
 from __future__ import annotations
@@ -40,13 +40,9 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from lqe_helpers.authoring import student_edition as se
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    read_notebook,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
+from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+from lqe_helpers.authoring.output_folder import write_output_folder
 
 #: Name of the tool in the output folder's manifest.
 TOOL_NAME = "student_pack"
@@ -274,7 +270,7 @@ def build_student_pack(root: Path, out_dir: Path, *,
     Raises
     ------
     ValueError
-        See :func:`pack_contents`; and :class:`~lqe_helpers.authoring.files.OutputFolderError`
+        See :func:`pack_contents`; and :class:`~lqe_helpers.authoring.errors.OutputFolderError`
         if ``out_dir`` cannot be used.
     """
     root = Path(root)
