@@ -5,8 +5,10 @@ Every byte the course tools write goes out through this module:
 - :func:`atomic_write_bytes` (and :func:`atomic_write_text`) writes a temporary file in
   the target's own folder, flushes it to disk and moves it over the target with
   :func:`os.replace`; on failure the target is untouched and the temporary file removed.
-- :func:`atomic_write_many` replaces several files, all or none.
-- :func:`write_new_file` creates a file that must not exist yet (a build's staged copy).
+- :func:`write_new_file` creates a file that must not exist yet (a build's staged copy);
+  :func:`link_or_copy` keeps a file's content under another name (a backup).
+- :func:`file_state` says what a file is now (size, modification time, SHA-256), so a
+  tool can tell whether someone changed it since it was read.
 - A target that is a symbolic link is refused, never written through nor replaced
   (:func:`refuse_symlink`).
 
@@ -20,10 +22,10 @@ import os
 import shutil
 import stat
 import tempfile
-from collections.abc import Mapping
+from dataclasses import dataclass
 from pathlib import Path
 
-from lqe_helpers.authoring.errors import FileSafetyError, OutputWriteError, error_line
+from lqe_helpers.authoring.errors import FileSafetyError
 
 
 def refuse_symlink(path: Path | str) -> None:
@@ -63,13 +65,8 @@ def _temporary_copy(path: Path, data: bytes) -> Path:
     fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-tmp")
     temporary = Path(name)
     try:
-        try:
-            mode = stat.S_IMODE(os.stat(path, follow_symlinks=False).st_mode)
-        except FileNotFoundError:
-            mode = new_file_mode()
-        os.fchmod(fd, mode)
-        _write_fd(fd, data)
-        os.fsync(fd)
+        os.fchmod(fd, mode_for(path))
+        _write_all(fd, data, path)
     except BaseException:
         os.close(fd)
         temporary.unlink(missing_ok=True)
@@ -78,8 +75,31 @@ def _temporary_copy(path: Path, data: bytes) -> Path:
     return temporary
 
 
-def _check_target(path: Path) -> None:
-    """Refuse a write target that is a link or a folder."""
+def mode_for(path: Path) -> int:
+    """Permission bits for a new version of ``path``: its own if it exists, else the umask's."""
+    try:
+        return stat.S_IMODE(os.stat(path, follow_symlinks=False).st_mode)
+    except FileNotFoundError:
+        return new_file_mode()
+
+
+def _write_all(fd: int, data: bytes, path: Path) -> None:
+    """Write ``data`` to ``fd`` and flush it to disk; a failure names ``path``.
+
+    ``os.write`` reports a full disk (ENOSPC) or a file-size limit (EFBIG, ``ulimit -f``)
+    without a file name; the error raised here carries ``path``.
+    """
+    try:
+        _write_fd(fd, data)
+        os.fsync(fd)
+    except OSError as error:
+        if error.filename is None and error.errno is not None:
+            raise OSError(error.errno, error.strerror, str(path)) from error
+        raise
+
+
+def check_target(path: Path) -> None:
+    """Refuse a write target that is a link or a folder (:class:`FileSafetyError`)."""
     refuse_symlink(path)
     if path.is_dir():
         raise FileSafetyError(f"{path} is a folder; expected a file to write")
@@ -114,7 +134,7 @@ def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
         If writing fails (``path`` is then unchanged).
     """
     path = Path(path)
-    _check_target(path)
+    check_target(path)
     temporary = _temporary_copy(path, data)
     try:
         os.replace(temporary, path)
@@ -129,107 +149,47 @@ def atomic_write_text(path: Path | str, text: str, encoding: str = "utf-8") -> P
     return atomic_write_bytes(path, text.encode(encoding))
 
 
-def atomic_write_many(files: Mapping[Path | str, bytes | str]) -> list[Path]:
-    """Replace (or create) several files, all or none.
-
-    Every new content is first written to a temporary file beside its target (a full
-    disk stops here, with nothing changed); then each target gets a hard-link backup
-    and is replaced with :func:`os.replace`. If any replacement fails, the ones already
-    made are undone from their backups, so every file is left as it was.
-
-    Parameters
-    ----------
-    files : mapping of Path to bytes or str
-        Target path → new content (``str`` is written as UTF-8).
-
-    Returns
-    -------
-    list of Path
-        The targets, in the mapping's order.
-
-    Raises
-    ------
-    FileSafetyError
-        If a target is a symbolic link or a folder (checked before anything is written).
-    OSError
-        If writing fails (every target is then as it was).
-    """
-    targets = {Path(path): as_bytes(data) for path, data in files.items()}
-    for path in targets:
-        _check_target(path)
-    staged: dict[Path, Path] = {}
-    backups: dict[Path, Path | None] = {}
-    replaced: list[Path] = []
-    keep_backups = False
-    try:
-        for path, data in targets.items():
-            staged[path] = _temporary_copy(path, data)
-        for path in targets:
-            backups[path] = _backup(path) if path.exists() else None
-        for path, temporary in staged.items():
-            os.replace(temporary, path)
-            replaced.append(path)
-    except BaseException as error:
-        try:
-            for path in reversed(replaced):
-                backup = backups.get(path)
-                if backup is not None:
-                    os.replace(backup, path)
-                else:
-                    path.unlink(missing_ok=True)
-        except OSError as undo_error:
-            keep_backups = True
-            kept = ", ".join(str(backup) for backup in backups.values() if backup)
-            raise OutputWriteError(
-                f"writing failed ({error_line(error)}) and so did putting the old files back "
-                f"({error_line(undo_error)}); the old files are kept as {kept}") from error
-        raise
-    finally:
-        for temporary in staged.values():
-            temporary.unlink(missing_ok=True)
-        if not keep_backups:
-            for backup in backups.values():
-                if backup is not None:
-                    backup.unlink(missing_ok=True)
-    return list(targets)
-
-
-def _backup(path: Path) -> Path:
-    """A hard link (else a copy) of ``path`` beside it, to put back if a replacement fails."""
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-old")
-    os.close(fd)
-    backup = Path(name)
-    backup.unlink()
-    try:
-        os.link(path, backup, follow_symlinks=False)
-    except OSError:
-        shutil.copy2(path, backup, follow_symlinks=False)
-    return backup
-
-
 def as_bytes(data: bytes | str) -> bytes:
     """``data`` as bytes (``str`` encoded as UTF-8)."""
     return data.encode("utf-8") if isinstance(data, str) else bytes(data)
 
 
-def write_new_file(path: Path, data: bytes) -> None:
+def write_new_file(path: Path, data: bytes, *, mode: int | None = None,
+                   named: Path | None = None) -> None:
     """Create the file ``path``, which must not exist yet, holding ``data`` (flushed to disk).
 
-    Its permission bits are the umask's (:func:`new_file_mode`).
+    Parameters
+    ----------
+    path : Path
+        The new file (its folder must exist).
+    data : bytes
+        Its content.
+    mode : int, optional
+        Its permission bits (default: the umask's, :func:`new_file_mode`).
+    named : Path, optional
+        The file a failure should name (default ``path``): the target of a staged copy.
 
     Raises
     ------
     FileExistsError
         If ``path`` exists (a link included).
     OSError
-        If writing fails.
+        If writing fails (naming ``named``).
     """
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, new_file_mode())
     try:
-        _write_fd(fd, data)
-        os.fsync(fd)
+        os.fchmod(fd, new_file_mode() if mode is None else mode)
+        _write_all(fd, data, path if named is None else named)
     finally:
         os.close(fd)
+
+
+def link_or_copy(source: Path, target: Path) -> None:
+    """Make ``target`` (new) hold ``source``'s content: a hard link, else a copy."""
+    try:
+        os.link(source, target, follow_symlinks=False)
+    except OSError:
+        shutil.copy2(source, target, follow_symlinks=False)
 
 
 def sha256(data: bytes) -> str:
@@ -238,8 +198,36 @@ def sha256(data: bytes) -> str:
 
 
 def file_sha256(path: Path) -> str | None:
-    """Hex SHA-256 of the file at ``path``, or ``None`` if it cannot be read."""
+    """Hex SHA-256 of the regular file at ``path``; ``None`` if it is missing, a link,
+    not a regular file, or cannot be read."""
     try:
+        if not stat.S_ISREG(os.lstat(path).st_mode):
+            return None
         return sha256(path.read_bytes())
     except OSError:
         return None
+
+
+@dataclass(frozen=True)
+class FileState:
+    """What a file was when a tool read it: size (bytes), modification time (ns), SHA-256."""
+
+    size: int
+    mtime_ns: int
+    sha256: str
+
+
+def file_state(path: Path, data: bytes | None = None) -> FileState | None:
+    """The :class:`FileState` of the regular file ``path`` now (``None`` if there is none).
+
+    ``data``, if given, is the content just read from ``path`` (hashed instead of
+    reading the file again).
+    """
+    try:
+        status = os.lstat(path)
+        if not stat.S_ISREG(status.st_mode):
+            return None
+        content = path.read_bytes() if data is None else data
+    except OSError:
+        return None
+    return FileState(status.st_size, status.st_mtime_ns, sha256(content))

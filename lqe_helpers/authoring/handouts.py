@@ -36,30 +36,33 @@ Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
 
 from __future__ import annotations
 
-import argparse
-import copy
-import warnings
-from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
-from urllib.parse import quote
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
-from nbconvert.filters import strip_ansi
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import copy
+    import warnings
+    from collections.abc import Sequence
+    from dataclasses import dataclass
+    from pathlib import Path
+    from urllib.parse import quote
 
-from lqe_helpers.authoring import handout_pages
-from lqe_helpers.authoring.command_line import CommandLineParser, run_command
-from lqe_helpers.authoring.errors import ToolError
-from lqe_helpers.authoring.handout_pages import handout_exporter
-from lqe_helpers.authoring.notebook_io import source_notebooks
-from lqe_helpers.authoring.notebook_runner import (
-    CELL_TIMEOUT,
-    WIDGET_VIEW_MIMETYPE,
-    NotebookRunError,
-    execute_notebook,
-    positive_seconds,
-)
-from lqe_helpers.authoring.output_folder import plan_output_folder, write_output_folder
+    import nbformat
+    from nbconvert.filters import strip_ansi
+
+    from lqe_helpers.authoring import handout_pages
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import ToolError
+    from lqe_helpers.authoring.execution import (
+        CELL_TIMEOUT,
+        WIDGET_VIEW_MIMETYPE,
+        NotebookRunError,
+        execute_notebook,
+        positive_seconds,
+    )
+    from lqe_helpers.authoring.handout_pages import handout_exporter
+    from lqe_helpers.authoring.notebook_io import source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"
@@ -237,7 +240,7 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
 
     The output folder is checked before any notebook runs, and written only once every
-    page is ready, all together (:func:`~lqe_helpers.authoring.output_folder.write_output_folder`):
+    page is ready, all together (:func:`~lqe_helpers.authoring.output_folder.build_output_folder`):
     any failure leaves it as it was. The build records what it wrote in the folder's
     manifest (``.lqe-manifest.json``); a rebuild replaces or deletes only those files,
     and only while they are unchanged. Every other file in the folder (an instructor's
@@ -283,13 +286,24 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     paths = source_notebooks(source_dir)
     local = mathjax_url == LOCAL_MATHJAX
     mathjax = handout_pages.mathjax_copy() if local else {}
-    plan_output_folder(out_dir, [*_page_names([path.stem for path in paths]), *mathjax],
-                       tool=TOOL_NAME, source_dir=source_dir)
-    executed = [(path, _execute(path, timeout)) for path in paths]
-    pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
+    page_names = _page_names([path.stem for path in paths])
 
-    # Every file of the build, relative to out_dir; anything else the handouts need
-    # (a copy of MathJax, say) goes in here too, so the manifest covers it.
+    def pages() -> dict[str, str | bytes]:
+        files = _render_pages([(path, _execute(path, timeout)) for path in paths],
+                              mathjax_url=mathjax_url)
+        files.update(mathjax)  # listed in the manifest too
+        return files
+
+    written = build_output_folder(out_dir, [*page_names, *mathjax], pages, tool=TOOL_NAME,
+                                  sources=[source_dir])
+    return written[:len(page_names)]
+
+
+def _render_pages(executed: Sequence[tuple[Path, nbformat.NotebookNode]], *,
+                  mathjax_url: str) -> dict[str, str | bytes]:
+    """Every page of the build (with and without code, and the two index pages)."""
+    local = mathjax_url == LOCAL_MATHJAX
+    pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
     files: dict[str, str | bytes] = {}
     for code, folder in ((True, ""), (False, f"{PROSE_DIR}/")):
         page_mathjax = handout_pages.mathjax_url(folder.count("/")) if local else mathjax_url
@@ -310,10 +324,7 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
         html, _ = exporter.from_notebook_node(
             _index_notebook(pages, code=code), {"metadata": {"name": "index"}})
         files[folder + "index.html"] = html
-    pages_written = len(files)
-    files.update(mathjax)
-    return write_output_folder(out_dir, files, tool=TOOL_NAME,
-                               source_dir=source_dir)[:pages_written]
+    return files
 
 
 def main(argv: Sequence[str] | None = None) -> int:

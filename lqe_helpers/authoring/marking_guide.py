@@ -23,28 +23,31 @@ a fresh run prints). The source notebooks are only read. The file is written thr
 
 from __future__ import annotations
 
-import argparse
-import inspect
-import re
-from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import inspect
+    import re
+    from collections.abc import Sequence
+    from dataclasses import dataclass
+    from pathlib import Path
 
-from lqe_helpers.authoring.command_line import CommandLineParser, run_command
-from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
-from lqe_helpers.authoring.output_folder import write_output_folder
-from lqe_helpers.authoring.task_cells import (
-    ANSWER_TAG,
-    CHECK_CALL,
-    GOING_FURTHER,
-    SOLUTION_TAG,
-    answer_headings,
-    cell_place,
-    cell_tags,
-    task_instruction,
-)
+    import nbformat
+
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
+    from lqe_helpers.authoring.task_cells import (
+        ANSWER_TAG,
+        CHECK_CALL,
+        GOING_FURTHER,
+        SOLUTION_TAG,
+        answer_headings,
+        cell_place,
+        cell_tags,
+        task_instruction,
+    )
 
 #: Name of the tool in the output folder's manifest.
 TOOL_NAME = "marking_guide"
@@ -337,7 +340,7 @@ def build_marking_guide(source_dir: Path, out_dir: Path) -> Path:
         Folder of the worked, executed notebooks (read only).
     out_dir : Path
         Folder for the guide (created if needed; the tool replaces only what it wrote
-        there, see :func:`lqe_helpers.authoring.output_folder.write_output_folder`).
+        there, see :func:`lqe_helpers.authoring.output_folder.build_output_folder`).
 
     Returns
     -------
@@ -351,10 +354,14 @@ def build_marking_guide(source_dir: Path, out_dir: Path) -> Path:
         are (the message says which).
     """
     source_dir = Path(source_dir)
-    guides = [notebook_guide(read_notebook(path), path.name)
-              for path in source_notebooks(source_dir)]
-    [written] = write_output_folder(out_dir, {GUIDE_NAME: render(guides, source_dir.as_posix())},
-                                    tool=TOOL_NAME, source_dir=source_dir)
+    paths = source_notebooks(source_dir)
+
+    def guide() -> dict[str, str]:
+        guides = [notebook_guide(read_notebook(path), path.name) for path in paths]
+        return {GUIDE_NAME: render(guides, source_dir.as_posix())}
+
+    [written] = build_output_folder(out_dir, [GUIDE_NAME], guide, tool=TOOL_NAME,
+                                    sources=[source_dir])
     return written
 
 

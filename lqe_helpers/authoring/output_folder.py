@@ -8,40 +8,36 @@
   rebuild replaces or deletes only files that are in that manifest *and* still hold
   exactly what the tool wrote; any other file in the folder is left alone, and a file
   the build would have to replace that is not the tool's stops the build before
-  anything is changed.
-- All or nothing: the build is written into a temporary folder first, then moved into
-  place; if anything fails, every moved file is put back.
-- :func:`remove_output_folder` deletes what a tool wrote (``make clean``).
+  anything is changed. A manifest entry that is not a plain relative path inside the
+  folder stops it too.
+- All or nothing, even under a kill: the build is one
+  :class:`~lqe_helpers.authoring.transaction.Transaction` (staged, journalled, then
+  moved into place); a failure is undone at once, a killed build is finished or undone
+  by the next tool that takes the folder.
+- One tool at a time: the folder is held (:class:`~lqe_helpers.authoring.transaction.
+  FolderLock`) for the whole build (:func:`build_output_folder`).
+- :func:`remove_output_folder` deletes what a tool wrote (``make clean``), and no
+  temporary folder but those a journal recorded.
 """
 
 from __future__ import annotations
 
-import errno
+import contextlib
 import os
-import shutil
-import tempfile
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
-from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError, error_line
-from lqe_helpers.authoring.files import (
-    as_bytes,
-    file_sha256,
-    sha256,
-    umask,
-    write_new_file,
-)
+from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError, shown, summarise
+from lqe_helpers.authoring.files import as_bytes, file_sha256, sha256
 from lqe_helpers.authoring.manifest import (
     MANIFEST_NAME,
     Manifest,
     blocked_parent,
-    check_name,
+    name_problem,
     read_manifest,
 )
-
-#: Prefix of the temporary folders of a build in progress (removed when it ends).
-STAGING_PREFIX = ".lqe-build-"
+from lqe_helpers.authoring.transaction import FolderLock, commit
 
 
 def _ancestors(path: Path) -> list[Path]:
@@ -87,6 +83,42 @@ def check_out_dir(source_dir: Path | str, out_dir: Path | str) -> None:
                     f"so a build could replace or delete source files; write it somewhere else")
 
 
+def check_output_location(out_dir: Path | str, sources: Sequence[Path | str] = ()) -> None:
+    """Refuse an output path that is a file or a broken link, or overlaps a source folder.
+
+    Raises
+    ------
+    OutputFolderError
+        If ``out_dir`` is a file, a broken symbolic link, or is, contains or lies inside
+        one of ``sources`` (:func:`check_out_dir`).
+    """
+    out_dir = Path(out_dir)
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OutputFolderError(f"the output folder {shown(out_dir)} is a file; give a folder")
+    if os.path.islink(out_dir) and not out_dir.exists():
+        raise OutputFolderError(f"the output folder {shown(out_dir)} is a broken symbolic link")
+    for source in sources:
+        check_out_dir(source, out_dir)
+
+
+def check_output_names(names: Iterable[str]) -> list[str]:
+    """The names a build writes, each once, after checking each is a plain relative path.
+
+    Raises
+    ------
+    ValueError
+        If a name is absolute, has an empty, ``.`` or ``..`` part, or starts with the
+        tools' reserved ``.lqe-``.
+    """
+    names = list(dict.fromkeys(names))
+    for name in names:
+        problem = name_problem(name)
+        if problem:
+            raise ValueError(f"output file names must be plain relative paths inside the "
+                             f"output folder, got {name!r} ({problem})")
+    return names
+
+
 @dataclass(frozen=True)
 class OutputPlan:
     """What :func:`write_output_folder` will do: checked before anything changes."""
@@ -98,14 +130,20 @@ class OutputPlan:
     create: tuple[str, ...]
     delete: tuple[str, ...]
     keep: tuple[str, ...]
+    ours: Mapping[str, str]
+
+
+def _problem_text(names: list[str], one: str, many: str) -> str:
+    """``"a was X"`` or ``"a, b, c and 5 more were X"`` (each fault said once)."""
+    return f"{summarise(names)} {one if len(names) == 1 else many}"
 
 
 def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
-                       source_dir: Path | str | None = None) -> OutputPlan:
+                       sources: Sequence[Path | str] = ()) -> OutputPlan:
     """Check that ``tool`` may write ``names`` into ``out_dir``; say what it would change.
 
     Call it before a long build to fail early; :func:`write_output_folder` calls it again
-    just before writing.
+    just before writing. Nothing is changed.
 
     Parameters
     ----------
@@ -115,8 +153,8 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
         Relative POSIX paths of the files the build writes (``"prose/index.html"``).
     tool : str
         The tool's name, recorded in the manifest.
-    source_dir : Path or str, optional
-        The source folder, which ``out_dir`` must not overlap (:func:`check_out_dir`).
+    sources : sequence of Path or str
+        The source folders, which ``out_dir`` must not overlap (:func:`check_out_dir`).
 
     Returns
     -------
@@ -124,78 +162,93 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
         ``replace``: files of ours to be overwritten; ``create``: new files; ``delete``:
         files of ours from an earlier build no longer written; ``keep``: files in the
         manifest that were changed or replaced since, and so are left alone (and dropped
-        from the manifest).
+        from the manifest); ``ours``: the manifest's entries.
 
     Raises
     ------
     OutputFolderError
-        If ``out_dir`` is a file, overlaps ``source_dir``, holds another tool's manifest,
-        or holds a file in the way that is not the tool's own unchanged output (or is a
-        link, or a folder).
+        If ``out_dir`` is a file, overlaps a source, holds another tool's manifest or a
+        manifest with an entry outside the folder, or holds a file in the way that is
+        not the tool's own unchanged output (or is a link, or a folder). Each fault is
+        said once, with how many files it concerns and the first few.
     """
     out_dir = Path(out_dir)
-    names = list(dict.fromkeys(names))
-    for name in names:
-        check_name(name)
-    if source_dir is not None:
-        check_out_dir(source_dir, out_dir)
-    elif out_dir.exists() and not out_dir.is_dir():
-        raise OutputFolderError(f"the output folder {out_dir} is a file; give a folder")
-    if os.path.islink(out_dir) and not out_dir.exists():
-        raise OutputFolderError(f"the output folder {out_dir} is a broken symbolic link")
+    names = check_output_names(names)
+    check_output_location(out_dir, sources)
     if not out_dir.exists():
-        return OutputPlan(out_dir, tool, False, (), tuple(names), (), ())
+        return OutputPlan(out_dir, tool, False, (), tuple(names), (), (), {})
     manifest = read_manifest(out_dir)
     if manifest is not None and manifest.tool != tool:
         raise OutputFolderError(
-            f"{out_dir} holds the output of {manifest.tool} (see its {MANIFEST_NAME}), "
-            f"not of {tool}; give {tool} a folder of its own")
+            f"{shown(out_dir)} holds the output of {shown(manifest.tool)} (see its "
+            f"{MANIFEST_NAME}), not of {tool}; give {tool} a folder of its own")
     ours = manifest.files if manifest is not None else {}
     unchanged = {name for name, digest in ours.items()
-                 if not os.path.islink(out_dir / name) and (out_dir / name).is_file()
-                 and file_sha256(out_dir / name) == digest}
-    problems, replace, create = [], [], []
+                 if file_sha256(out_dir / name) == digest}
+    blocked: dict[str, None] = {}
+    faults: dict[str, list[str]] = {"link": [], "folder": [], "changed": [], "foreign": []}
+    replace, create = [], []
     for name in names:
         target = out_dir / name
-        blocked = blocked_parent(out_dir, PurePosixPath(name))
-        if blocked:
-            problems.append(blocked)
+        why = blocked_parent(out_dir, PurePosixPath(name))
+        if why:
+            blocked[why] = None
         elif os.path.islink(target):
-            problems.append(f"{name} is a symbolic link")
+            faults["link"].append(name)
         elif target.is_dir():
-            problems.append(f"{name} is a folder")
+            faults["folder"].append(name)
         elif not target.exists():
             create.append(name)
         elif name in unchanged:
             replace.append(name)
-        elif name in ours:
-            problems.append(f"{name} was changed since {tool} wrote it")
         else:
-            problems.append(f"{name} was not written by {tool}")
+            faults["changed" if name in ours else "foreign"].append(name)
+    problems = [*blocked]
+    for kind, one, many in (
+            ("link", "is a symbolic link", "are symbolic links"),
+            ("folder", "is a folder", "are folders"),
+            ("changed", f"was changed since {tool} wrote it",
+             f"were changed since {tool} wrote them"),
+            ("foreign", f"was not written by {tool}", f"were not written by {tool}")):
+        if faults[kind]:
+            problems.append(_problem_text(faults[kind], one, many))
     if problems:
         raise OutputFolderError(
-            f"{tool} will not write into {out_dir}: {'; '.join(problems)}. Nothing was "
+            f"{tool} will not write into {shown(out_dir)}: {'; '.join(problems)}. Nothing was "
             f"changed; move those files away, or give another output folder")
     wanted = set(names)
     delete = sorted(name for name in unchanged if name not in wanted)
     keep = sorted(name for name in ours if name not in wanted and name not in unchanged)
     return OutputPlan(out_dir, tool, True, tuple(replace), tuple(create), tuple(delete),
-                      tuple(keep))
+                      tuple(keep), dict(ours))
+
+
+@contextlib.contextmanager
+def _held_folder(out_dir: Path) -> Iterator[bool]:
+    """Create ``out_dir`` if needed and hold it (:class:`FolderLock`); yield whether it was
+    created. A folder created here that is empty when the block fails is removed again."""
+    created = not out_dir.exists()
+    out_dir.mkdir(parents=True, exist_ok=True)
+    try:
+        with FolderLock(out_dir):
+            yield created
+    except BaseException:
+        if created:
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()  # only if empty
+        raise
 
 
 def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *, tool: str,
-                        source_dir: Path | str | None = None) -> list[Path]:
+                        sources: Sequence[Path | str] = ()) -> list[Path]:
     """Write a whole build into ``out_dir``, all or nothing, touching only the tool's files.
 
-    Checks first (:func:`plan_output_folder`): a file in the way that the tool did not
-    write, or changed since, stops the build before anything is written. Then:
-
-    - ``out_dir`` missing: everything (with the manifest) is written into a temporary
-      folder beside it, which is then renamed to ``out_dir``;
-    - ``out_dir`` present: everything is written into a hidden temporary folder inside
-      it, then each file is moved into place (the file it replaces kept as a hard link),
-      files of an earlier build that this one no longer writes are deleted, and the
-      manifest is rewritten. If any step fails, every change is undone.
+    Holds the folder (created if needed), checks (:func:`plan_output_folder`): a file in
+    the way that the tool did not write, or changed since, stops the build before
+    anything is written. Then every file (and the manifest, last) is moved into place
+    as one :class:`~lqe_helpers.authoring.transaction.Transaction`, and the files of an
+    earlier build that this one no longer writes are deleted. A failure undoes every
+    change; a kill is finished or undone by the next tool that takes the folder.
 
     Parameters
     ----------
@@ -205,8 +258,8 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
         Relative POSIX path → content (``str`` is written as UTF-8).
     tool : str
         The tool's name (recorded in the manifest :data:`MANIFEST_NAME`).
-    source_dir : Path or str, optional
-        The folder the build reads, which ``out_dir`` must not overlap.
+    sources : sequence of Path or str
+        The folders the build reads, which ``out_dir`` must not overlap.
 
     Returns
     -------
@@ -223,105 +276,70 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
     """
     out_dir = Path(out_dir)
     contents = {name: as_bytes(data) for name, data in files.items()}
-    plan = plan_output_folder(out_dir, contents, tool=tool, source_dir=source_dir)
-    manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
+    check_output_names(contents)
+    check_output_location(out_dir, sources)
     try:
-        if plan.exists:
-            _commit_into(out_dir, contents, manifest.to_bytes(), plan.delete)
-        else:
-            _create_folder(out_dir, contents, manifest.to_bytes())
+        with _held_folder(out_dir):
+            plan = plan_output_folder(out_dir, contents, tool=tool, sources=sources)
+            manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
+            expected: dict[str, str | None] = {name: None for name in plan.create}
+            expected.update({name: plan.ours[name] for name in (*plan.replace, *plan.delete)})
+            commit(out_dir, {**contents, MANIFEST_NAME: manifest.to_bytes()}, plan.delete,
+                   tool=tool, expected=expected)
     except OSError as error:
-        where = f" ({error.filename})" if error.filename else ""
+        where = f" ({shown(error.filename)})" if error.filename else ""
         raise OutputWriteError(
-            f"cannot write into {out_dir}: {error.strerror or error}{where}; "
+            f"cannot write into {shown(out_dir)}: {error.strerror or error}{where}; "
             f"it was left as it was") from error
     return [out_dir / name for name in contents]
 
 
-def _stage(folder: Path, contents: Mapping[str, bytes], manifest: bytes | None) -> None:
-    """Write ``contents`` (and the manifest) as files under the new folder ``folder``."""
-    for name, data in contents.items():
-        path = folder / name
-        path.parent.mkdir(parents=True, exist_ok=True)
-        write_new_file(path, data)
-    if manifest is not None:
-        _stage(folder, {MANIFEST_NAME: manifest}, None)
+def build_output_folder(out_dir: Path | str, names: Sequence[str],
+                        build: Callable[[], Mapping[str, bytes | str]], *, tool: str,
+                        sources: Sequence[Path | str] = ()) -> list[Path]:
+    """Check ``out_dir``, run ``build()``, write what it returns: every tool's one shape.
 
+    The folder is checked for ``names`` before the (perhaps long) build, and held for
+    the whole of it if it exists already, so a second tool on it stops at once; then
+    :func:`write_output_folder` writes the files ``build`` returns.
 
-def _create_folder(out_dir: Path, contents: Mapping[str, bytes], manifest: bytes) -> None:
-    """Build a new ``out_dir`` beside it, then rename it into place."""
-    out_dir.parent.mkdir(parents=True, exist_ok=True)
-    staging = Path(tempfile.mkdtemp(dir=out_dir.parent, prefix=f".{out_dir.name}{STAGING_PREFIX}"))
-    try:
-        os.chmod(staging, 0o777 & ~umask())
-        _stage(staging, contents, manifest)
-        if out_dir.exists() or os.path.islink(out_dir):
-            raise OSError(errno.EEXIST, "appeared while the build ran", str(out_dir))
-        os.rename(staging, out_dir)
-    except BaseException:
-        shutil.rmtree(staging, ignore_errors=True)
-        raise
+    Parameters
+    ----------
+    out_dir : Path or str
+        The output folder.
+    names : sequence of str
+        The files the build will write (checked before ``build`` runs).
+    build : callable
+        Reads the sources and returns relative path → content.
+    tool : str
+        The tool's name (in the manifest).
+    sources : sequence of Path or str
+        The folders the build reads, which ``out_dir`` must not overlap.
 
-
-def _commit_into(out_dir: Path, contents: Mapping[str, bytes], manifest: bytes,
-                 delete: Sequence[str]) -> None:
-    """Stage inside ``out_dir``, move each file into place; undo everything on failure."""
-    staging = Path(tempfile.mkdtemp(dir=out_dir, prefix=STAGING_PREFIX))
-    new, old = staging / "new", staging / "old"
-    undo: list[tuple[Path, Path | None]] = []  # (target, its backup or None if it was new)
-    created: list[Path] = []
-    restored = True
-    try:
-        _stage(new, contents, manifest)
-        for name in [*contents, MANIFEST_NAME]:
-            target = out_dir / name
-            for folder in reversed(target.relative_to(out_dir).parents[:-1]):
-                if not (out_dir / folder).exists():
-                    (out_dir / folder).mkdir()
-                    created.append(out_dir / folder)
-            backup = None
-            if os.path.lexists(target):
-                backup = old / name
-                backup.parent.mkdir(parents=True, exist_ok=True)
-                try:
-                    os.link(target, backup, follow_symlinks=False)
-                except OSError:
-                    shutil.copy2(target, backup, follow_symlinks=False)
-            os.replace(new / name, target)
-            undo.append((target, backup))
-        for name in delete:
-            backup = old / name
-            backup.parent.mkdir(parents=True, exist_ok=True)
-            os.replace(out_dir / name, backup)
-            undo.append((out_dir / name, backup))
-    except BaseException as error:
-        try:
-            for target, backup in reversed(undo):
-                if backup is None:
-                    target.unlink(missing_ok=True)
-                else:
-                    os.replace(backup, target)
-            for folder in reversed(created):
-                folder.rmdir()
-        except OSError as undo_error:
-            restored = False
-            raise OutputWriteError(
-                f"writing into {out_dir} failed ({error_line(error)}) and so did putting the "
-                f"old files back ({error_line(undo_error)}); the old files are kept in "
-                f"{old}") from error
-        raise
-    finally:
-        if restored:
-            shutil.rmtree(staging, ignore_errors=True)
+    Returns
+    -------
+    list of Path
+        The written files, in the order ``build`` returned them.
+    """
+    out_dir = Path(out_dir)
+    plan_output_folder(out_dir, names, tool=tool, sources=sources)
+    held = FolderLock(out_dir) if out_dir.is_dir() else contextlib.nullcontext()
+    with held:
+        plan_output_folder(out_dir, names, tool=tool, sources=sources)
+        files = build()
+        return write_output_folder(out_dir, files, tool=tool, sources=sources)
 
 
 def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
     """Delete what a tool wrote in ``out_dir`` (per its manifest); the folder too if then empty.
 
-    Only files listed in the manifest that still hold exactly what the tool wrote are
-    deleted, then the manifest, the temporary folders of an interrupted build, and the
-    sub-folders of listed files (and ``out_dir``) that are left empty. Everything else
-    stays. A folder without a manifest is left alone entirely.
+    The folder is held (:class:`~lqe_helpers.authoring.transaction.FolderLock`), so a
+    build killed part-way is first finished or undone from its journal. Then only files
+    listed in the manifest that still hold exactly what the tool wrote are deleted, then
+    the manifest and the sub-folders of listed files (and ``out_dir``) that are left
+    empty. Everything else stays, including a folder named like a tool's temporary
+    folder (``.lqe-build-…``) that no journal recorded. A folder without a manifest is
+    left alone entirely, and so is one whose manifest lists a name outside it.
 
     Parameters
     ----------
@@ -334,32 +352,34 @@ def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
         The deleted files.
     kept : list of Path
         The files left in ``out_dir`` (not the tool's, or changed since it wrote them).
+
+    Raises
+    ------
+    OutputFolderError
+        If the manifest or journal cannot be trusted, or another tool holds the folder;
+        nothing is deleted then.
     """
     out_dir = Path(out_dir)
-    if not out_dir.is_dir():
+    if not out_dir.is_dir() or out_dir.is_symlink():
         return [], []
-    for staging in [*out_dir.glob(f"{STAGING_PREFIX}*"),
-                    *out_dir.parent.glob(f".{out_dir.name}{STAGING_PREFIX}*")]:
-        if staging.is_dir() and not staging.is_symlink():
-            shutil.rmtree(staging)
-    manifest = read_manifest(out_dir)
     removed: list[Path] = []
-    folders: set[Path] = set()
-    if manifest is not None:
-        for name, digest in sorted(manifest.files.items()):
-            check_name(name)
-            path = out_dir / name
-            folders.update(out_dir / parent for parent in PurePosixPath(name).parents[:-1])
-            if (not os.path.islink(path) and path.is_file() and not blocked_parent(
-                    out_dir, PurePosixPath(name)) and file_sha256(path) == digest):
-                path.unlink()
-                removed.append(path)
-        (out_dir / MANIFEST_NAME).unlink()
-        for folder in sorted(folders, key=lambda path: len(path.parts), reverse=True):
-            if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
-                folder.rmdir()
-        if not out_dir.is_symlink() and not any(out_dir.iterdir()):
-            out_dir.rmdir()
+    with FolderLock(out_dir):
+        manifest = read_manifest(out_dir)
+        if manifest is not None:
+            folders: set[Path] = set()
+            for name, digest in sorted(manifest.files.items()):
+                path = out_dir / name
+                folders.update(out_dir / parent for parent in PurePosixPath(name).parents[:-1])
+                if file_sha256(path) == digest:
+                    path.unlink()
+                    removed.append(path)
+            (out_dir / MANIFEST_NAME).unlink()
+            for folder in sorted(folders, key=lambda path: len(path.parts), reverse=True):
+                if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
+                    folder.rmdir()
+    if manifest is not None and not any(out_dir.iterdir()):
+        out_dir.rmdir()
     kept = sorted(path for path in out_dir.rglob("*") if not path.is_dir()) \
         if out_dir.exists() else []
     return removed, kept
+

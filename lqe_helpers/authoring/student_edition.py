@@ -46,55 +46,58 @@ builds it anyway, with a warning.
 
 from __future__ import annotations
 
-import argparse
-import copy
-import warnings
-from collections.abc import Sequence
-from pathlib import Path
-from typing import Any
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
-from nbconvert.exporters import NotebookExporter
-from nbconvert.preprocessors import (
-    ClearMetadataPreprocessor,
-    ClearOutputPreprocessor,
-    Preprocessor,
-)
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import copy
+    import warnings
+    from collections.abc import Sequence
+    from pathlib import Path
+    from typing import Any
 
-from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    import nbformat
+    from nbconvert.exporters import NotebookExporter
+    from nbconvert.preprocessors import (
+        ClearMetadataPreprocessor,
+        ClearOutputPreprocessor,
+        Preprocessor,
+    )
 
-# MANIFEST_NAME and the Output*Error classes are re-exported: where the build records
-# what it wrote, and what build_student_edition raises.
-from lqe_helpers.authoring.errors import OutputFolderError as OutputFolderError
-from lqe_helpers.authoring.errors import OutputWriteError as OutputWriteError
-from lqe_helpers.authoring.manifest import MANIFEST_NAME as MANIFEST_NAME
-from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
-from lqe_helpers.authoring.output_folder import check_out_dir, write_output_folder
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
 
-# The cell convention is part of the student edition's interface: re-exported here.
-from lqe_helpers.authoring.task_cells import (
-    ALLOWED_TAGS,
-    ANSWER_PROMPT,
-    ANSWER_PROMPT_TAG,
-    ANSWER_TAG,
-    CHECK_CALL,
-    EXPLORER_TAG,
-    GOING_FURTHER,
-    IGNORE_OUTPUT_TAG,
-    SOLUTION_TAG,
-    STUB_MESSAGE,
-    TASK_LIKE,
-    TASK_PREFIX,
-    TASK_TAG,
-    answer_headings,
-    cell_place,
-    cell_tags,
-    check_cell_tags,
-    function_stub,
-    prompt_source,
-    stub_source,
-    task_instruction,
-)
+    # MANIFEST_NAME and the Output*Error classes are re-exported: where the build records
+    # what it wrote, and what build_student_edition raises.
+    from lqe_helpers.authoring.errors import OutputFolderError as OutputFolderError
+    from lqe_helpers.authoring.errors import OutputWriteError as OutputWriteError
+    from lqe_helpers.authoring.manifest import MANIFEST_NAME as MANIFEST_NAME
+    from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
+
+    # The cell convention is part of the student edition's interface: re-exported here.
+    from lqe_helpers.authoring.task_cells import (
+        ALLOWED_TAGS,
+        ANSWER_PROMPT,
+        ANSWER_PROMPT_TAG,
+        ANSWER_TAG,
+        CHECK_CALL,
+        EXPLORER_TAG,
+        GOING_FURTHER,
+        IGNORE_OUTPUT_TAG,
+        SOLUTION_TAG,
+        STUB_MESSAGE,
+        TASK_LIKE,
+        TASK_PREFIX,
+        TASK_TAG,
+        answer_headings,
+        cell_place,
+        cell_tags,
+        check_cell_tags,
+        function_stub,
+        prompt_source,
+        stub_source,
+        task_instruction,
+    )
 
 __all__ = [
     "ALLOWED_TAGS",
@@ -297,7 +300,7 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
     """Write the student edition of every notebook in ``source_dir`` to ``out_dir``.
 
     Every notebook is read and transformed before anything is written, and the files
-    are written together (:func:`~lqe_helpers.authoring.output_folder.write_output_folder`), so
+    are written together (:func:`~lqe_helpers.authoring.output_folder.build_output_folder`), so
     a refused or failed build leaves ``out_dir`` as it was. The folder's manifest
     (``.lqe-manifest.json``) lists what the build wrote; a rebuild replaces or deletes
     only those files, and only while unchanged (an edition of a notebook since renamed
@@ -334,14 +337,18 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
     paths = source_notebooks(source_dir)
-    check_out_dir(source_dir, out_dir)
-    editions: dict[str, str] = {}
-    for path in paths:
-        notebook = read_notebook(path)
-        check_has_solutions(notebook, path.name,
-                            allow_without_solutions=allow_without_solutions)
-        editions[path.name] = student_edition(notebook, path.stem)
-    return write_output_folder(out_dir, editions, tool=TOOL_NAME, source_dir=source_dir)
+
+    def editions() -> dict[str, str]:
+        built = {}
+        for path in paths:
+            notebook = read_notebook(path)
+            check_has_solutions(notebook, path.name,
+                                allow_without_solutions=allow_without_solutions)
+            built[path.name] = student_edition(notebook, path.stem)
+        return built
+
+    return build_output_folder(out_dir, [path.name for path in paths], editions,
+                               tool=TOOL_NAME, sources=[source_dir])
 
 
 def main(argv: Sequence[str] | None = None) -> int:
