@@ -25,7 +25,6 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
@@ -39,20 +38,11 @@ JOURNAL_NAME = ".lqe-journal.json"
 JOURNAL_FORMAT = 1
 #: Prefix of the temporary folder of a build in progress (inside the folder it writes).
 STAGING_PREFIX = ".lqe-build-"
-#: For tests only: the point at which a tool kills itself with SIGKILL (``"staged"``,
-#: ``"journal"``, ``"rename:N"`` before the N-th move, ``"renamed"``, ``"cleaned"``).
-KILL_AT_VARIABLE = "LQE_TOOLS_KILL_AT"
 _STATES = ("staging", "committing", "rolling-back")
 
 
 class RecoveryWarning(UserWarning):
     """A tool found a build that was killed part-way, and finished or undid it."""
-
-
-def kill_point(point: str) -> None:
-    """Die here with SIGKILL if :data:`KILL_AT_VARIABLE` names ``point`` (for tests)."""
-    if os.environ.get(KILL_AT_VARIABLE) == point:
-        os.kill(os.getpid(), signal.SIGKILL)
 
 
 @dataclass(frozen=True)
@@ -128,7 +118,6 @@ def finish(folder: Path, journal: Journal) -> None:
     staging = folder / journal.staging
     if staging.is_dir() and not staging.is_symlink():
         shutil.rmtree(staging)
-    kill_point("cleaned")
     (folder / JOURNAL_NAME).unlink(missing_ok=True)
 
 
@@ -142,13 +131,12 @@ def roll_forward(folder: Path, journal: Journal, *, strict: bool) -> list[str]:
     for name in journal.folders:
         (folder / name).mkdir(exist_ok=True)
     kept = []
-    for number, step in enumerate(journal.steps, start=1):
+    for step in journal.steps:
         target = folder / step.name
         now = file_sha256(target) if os.path.lexists(target) else None
         staged = staged_root / step.name
         if step.new is None:
             if now is not None and now == step.old:
-                kill_point(f"rename:{number}")
                 target.unlink()
             continue
         if not os.path.lexists(staged):
@@ -159,7 +147,6 @@ def roll_forward(folder: Path, journal: Journal, *, strict: bool) -> list[str]:
                                         f"nothing was changed")
             kept.append(step.name)
             continue
-        kill_point(f"rename:{number}")
         os.replace(staged, target)
     return kept
 

@@ -44,7 +44,6 @@ from lqe_helpers.authoring.journal import (
     RecoveryWarning,
     Step,
     finish,
-    kill_point,
     recover,
     roll_back,
     roll_forward,
@@ -165,7 +164,6 @@ class Transaction:
         for name in deletes:
             self.journal.steps.append(Step(name, None, self._keep_old(name)))
         self.journal.folders = folders
-        kill_point("staged")
 
     def _keep_old(self, name: str) -> str | None:
         """A hard link (or copy) of the file ``name`` in the temporary folder; its SHA-256."""
@@ -202,9 +200,7 @@ class Transaction:
         self.journal.steps = [step for step in self.journal.steps if step.name not in changed]
         self.journal.state = "committing"
         write_journal(self.folder, self.journal)
-        kill_point("journal")
         kept = roll_forward(self.folder, self.journal, strict=strict)
-        kill_point("renamed")
         return changed + kept
 
     def finish(self) -> None:
