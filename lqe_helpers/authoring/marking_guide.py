@@ -46,6 +46,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         answer_headings,
         cell_place,
         cell_tags,
+        check_cell_tags,
         task_instruction,
     )
 
@@ -231,8 +232,9 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     Raises
     ------
     ValueError
-        If the notebook was never executed (no expected values), a cell saved an
-        error, a check cell calls an unknown check, or its marks are wrong.
+        If the notebook was never executed (no expected values), a cell breaks the tag
+        convention (a misspelt ``solution`` tag would drop its task from the guide), a
+        cell saved an error, a check cell calls an unknown check, or its marks are wrong.
     """
     question, marks = question_and_marks(notebook, name)
     cells = notebook.cells
@@ -244,6 +246,7 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     for index, cell in enumerate(cells):
         tags = cell_tags(cell)
         where = cell_place(name, index, cell)
+        check_cell_tags(cell, where)  # a misspelt tag would drop a task from the guide
         if cell.cell_type == "markdown" and cell.source.lstrip().startswith(GOING_FURTHER):
             core = False
         if SOLUTION_TAG in tags:

@@ -254,9 +254,14 @@ def check_has_solutions(notebook: nbformat.NotebookNode, name: str, *,
 
     Raises
     ------
+    ValueError
+        If a cell breaks the tag convention (:func:`check_cell_tags`), checked first: a
+        misspelt ``solution`` tag is named as such, not reported as a missing one.
     MissingSolutionsError
         If no cell is tagged ``solution`` and ``allow_without_solutions`` is false.
     """
+    for index, cell in enumerate(notebook.cells):
+        check_cell_tags(cell, cell_place(name.removesuffix(".ipynb"), index, cell))
     if count_solutions(notebook):
         return
     if not allow_without_solutions:

@@ -33,8 +33,8 @@ TASK_TAG = "task"
 ANSWER_PROMPT_TAG = "answer-prompt"
 #: How the instruction at the top of a solution cell starts.
 TASK_PREFIX = "# Task:"
-#: A first line that looks like a task instruction, however it is spelt or spaced.
-TASK_LIKE = re.compile(r"#\s*task\s*:", re.IGNORECASE)
+#: A comment line that looks like a task instruction, however it is spelt or spaced.
+TASK_LIKE = re.compile(r"#+\s*task\s*:", re.IGNORECASE)
 #: The heading that ends the core path of a notebook (what follows is optional).
 GOING_FURTHER = "## Going further"
 #: How the call in the check cell after a core task starts.
@@ -217,8 +217,8 @@ def check_cell_tags(cell: nbformat.NotebookNode, where: str) -> None:
         If the cell carries a tag outside :data:`ALLOWED_TAGS` (the message suggests
         the nearest allowed one), a tag on the wrong kind of cell, ``solution`` and
         ``answer`` together, an explorer also marked as a solution or an answer or
-        without ``nbval-ignore-output``, or if it is a code cell that starts like a
-        task (``# Task:``) without the ``solution`` tag.
+        without ``nbval-ignore-output``, or if it is a code cell whose leading comments
+        hold a task instruction (:func:`looks_like_a_task`) without the ``solution`` tag.
     """
     tags = cell_tags(cell)
     for tag in tags:
@@ -247,7 +247,24 @@ def check_cell_tags(cell: nbformat.NotebookNode, where: str) -> None:
     if is_answer and cell.cell_type != "markdown":
         raise ValueError(f"{where}: tag {ANSWER_TAG!r} is for markdown cells, got a "
                          f"{cell.cell_type} cell")
-    if (cell.cell_type == "code" and not is_solution
-            and TASK_LIKE.match(cell.source.lstrip())):
-        raise ValueError(f"{where}: starts like a task but is not tagged {SOLUTION_TAG!r}, "
-                         f"so its worked code would be handed out; tag it {SOLUTION_TAG!r}")
+    if cell.cell_type == "code" and not is_solution and looks_like_a_task(cell.source):
+        raise ValueError(f"{where}: starts like a task but is not tagged {SOLUTION_TAG!r} (a "
+                         f"'# Task:' comment at its top), so its worked code would be handed "
+                         f"out; tag it {SOLUTION_TAG!r}")
+
+
+def looks_like_a_task(source: str) -> bool:
+    """Whether a code cell's leading block holds a task instruction.
+
+    The leading block is every line before the first line of code: blank lines,
+    comments and IPython magics (``%%time``, ``!pip ...``). A comment there that reads
+    like ``# Task:`` (:data:`TASK_LIKE`: any case, spacing or number of ``#``) makes the
+    cell a task, wherever it is in the block.
+    """
+    for line in source.splitlines():
+        stripped = line.strip()
+        if stripped and not stripped.startswith(("#", "%", "!")):
+            return False
+        if TASK_LIKE.match(stripped):
+            return True
+    return False
