@@ -62,7 +62,7 @@ def shown(name: object) -> str:
     return repr(text) if _CONTROL.search(text) else text
 
 
-def summarise(places: Sequence[str], limit: int = NAMED_PLACES) -> str:
+def summarise(places: Sequence[str], limit: int = NAMED_PLACES, separator: str = ", ") -> str:
     """``places`` named once each: all of them, or the first ``limit`` and how many more.
 
     ``["a", "b", "c", "d", "e"]`` → ``"a, b, c and 2 more"``; each place goes through
@@ -70,7 +70,7 @@ def summarise(places: Sequence[str], limit: int = NAMED_PLACES) -> str:
     """
     named = [shown(place) for place in places[:limit]]
     more = len(places) - len(named)
-    return ", ".join(named) + (f" and {more} more" if more > 0 else "")
+    return separator.join(named) + (f" and {more} more" if more > 0 else "")
 
 
 def error_line(error: BaseException) -> str:

@@ -52,7 +52,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring import handout_pages
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
-    from lqe_helpers.authoring.errors import ToolError
+    from lqe_helpers.authoring.errors import ToolError, summarise
     from lqe_helpers.authoring.execution import (
         CELL_TIMEOUT,
         WIDGET_VIEW_MIMETYPE,
@@ -195,11 +195,11 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
 def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode:
     """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
 
-    Every cell runs even after one raises, so the message can name each cell that
-    shows an error (the first is usually the cause; later ones may follow from it)
-    and give the first traceback. A cell past ``timeout`` seconds or a kernel that
-    dies stops the build too. Warns (:class:`HandoutWarning`) if a cell printed to
-    stderr.
+    Every cell runs even after one raises, so the message can name the cells that
+    show an error (the first few, and how many more: the first is usually the cause;
+    later ones may follow from it) and give the first traceback. A cell past
+    ``timeout`` seconds or a kernel that dies stops the build too. Warns
+    (:class:`HandoutWarning`) if a cell printed to stderr.
     """
     try:
         notebook = execute_notebook(path, timeout, allow_errors=True)
@@ -207,23 +207,25 @@ def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode
         raise HandoutBuildError(str(error)) from error
     errors = error_outputs(notebook)
     if errors:
-        raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}\n"
+        raise HandoutBuildError(f"{path} shows error output(s): "
+                                f"{summarise(errors, separator='; ')}\n"
                                 f"Traceback of the first, {error_tracebacks(notebook)[0]}")
     widgets = unshowable_widgets(notebook)
     if widgets:
         raise HandoutBuildError(
             f"{path} displays widget(s) with no static view, which a page could only show "
-            f"as a placeholder (display an Explorer, or a figure): {'; '.join(widgets)}")
+            f"as a placeholder (display an Explorer, or a figure): "
+            f"{summarise(widgets, separator='; ')}")
     undescribed = handout_pages.undescribed_figures(notebook)
     if undescribed:
         warnings.warn(f"{path} shows figure(s) with no description, which its page can "
                       f"only give a generic alt text (show them with plotting.show_figure): "
-                      f"{'; '.join(undescribed)}",
+                      f"{summarise(undescribed, separator='; ')}",
                       HandoutWarning, stacklevel=3)
     printed = stderr_outputs(notebook)
     if printed:
         warnings.warn(f"{path} prints to stderr, which its page will show: "
-                      f"{'; '.join(printed)}", HandoutWarning, stacklevel=3)
+                      f"{summarise(printed, separator='; ')}", HandoutWarning, stacklevel=3)
     notebook.metadata.pop("widgets", None)
     return notebook
 
