@@ -37,6 +37,9 @@ from lqe_helpers.authoring.notebook_io import read_notebook
 
 #: Default for the seconds one cell may run before the run is abandoned (``--timeout``).
 CELL_TIMEOUT = 300
+#: The longest time limit a cell may be given (a week, in seconds); nbclient fails on
+#: limits near the largest float.
+MAX_TIMEOUT = 7 * 24 * 3600
 #: Output mimetype of a displayed ipywidget.
 WIDGET_VIEW_MIMETYPE = "application/vnd.jupyter.widget-view+json"
 #: Seconds past a cell's time limit (or the kernel's start-up limit) after which the run
@@ -55,13 +58,14 @@ class NotebookRunError(ToolError, RuntimeError):
 
 
 def positive_seconds(text: str) -> float:
-    """``--timeout``'s type: a finite number of seconds > 0."""
+    """``--timeout``'s type: a number of seconds > 0 and at most :data:`MAX_TIMEOUT`."""
     try:
         value = float(text)
     except ValueError:
         value = float("nan")
-    if not value > 0 or value == float("inf"):
-        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r}")
+    if not 0 < value <= MAX_TIMEOUT:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r} (at "
+                                         f"most {MAX_TIMEOUT}, a week)")
     return value
 
 
@@ -261,10 +265,12 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
         On Ctrl-C or SIGTERM: the kernel is stopped first; the message names the
         notebook and the cell.
     ValueError
-        If ``timeout`` is not a positive number of seconds.
+        If ``timeout`` is not a number of seconds > 0 and at most :data:`MAX_TIMEOUT`.
     """
-    if isinstance(timeout, bool) or not isinstance(timeout, int | float) or not timeout > 0:
-        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r}")
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
+            or not 0 < timeout <= MAX_TIMEOUT:
+        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r} (at most "
+                         f"{MAX_TIMEOUT}, a week)")
     path = Path(path)
     notebook = read_notebook(path)
     _KernelRun(notebook, path, timeout, kernel_name, allow_errors).execute()

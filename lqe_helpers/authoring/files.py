@@ -203,7 +203,11 @@ def file_sha256(path: Path) -> str | None:
     try:
         if not stat.S_ISREG(os.lstat(path).st_mode):
             return None
-        return sha256(path.read_bytes())
+        digest = hashlib.sha256()
+        with open(path, "rb") as file:  # in pieces: a file in the way may be huge
+            while piece := file.read(2**20):
+                digest.update(piece)
+        return digest.hexdigest()
     except OSError:
         return None
 

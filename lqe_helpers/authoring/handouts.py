@@ -52,7 +52,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring import handout_pages
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
-    from lqe_helpers.authoring.errors import ToolError, summarise
+    from lqe_helpers.authoring.errors import ToolError, shown, summarise
     from lqe_helpers.authoring.execution import (
         CELL_TIMEOUT,
         WIDGET_VIEW_MIMETYPE,
@@ -349,7 +349,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def command(args: argparse.Namespace) -> int:
         for path in build_handouts(args.source, args.out, mathjax_url=args.mathjax_url,
                                    timeout=args.timeout):
-            print(path)
+            print(shown(path))
         return 0
 
     return run_command(parser, command, argv)

@@ -28,7 +28,7 @@ import shutil
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
-from lqe_helpers.authoring.errors import OutputFolderError, shown
+from lqe_helpers.authoring.errors import OutputFolderError, shown, summarise
 from lqe_helpers.authoring.files import atomic_write_bytes, file_sha256
 from lqe_helpers.authoring.manifest import entry_problem
 
@@ -39,6 +39,8 @@ JOURNAL_FORMAT = 1
 #: Prefix of the temporary folder of a build in progress (inside the folder it writes).
 STAGING_PREFIX = ".lqe-build-"
 _STATES = ("staging", "committing", "rolling-back")
+#: The largest journal the tools read (bytes): a build of thousands of files is < 1 MB.
+MAX_JOURNAL_BYTES = 64 * 2**20
 
 
 class RecoveryWarning(UserWarning):
@@ -86,6 +88,8 @@ def read_journal(folder: Path) -> Journal | None:
     if not os.path.lexists(path):
         return None
     try:
+        if os.path.islink(path) or os.path.getsize(path) > MAX_JOURNAL_BYTES:
+            raise ValueError("a link, or too large")
         content = json.loads(path.read_bytes().decode("utf-8"))
         journal = Journal(content["tool"], content["state"], content["staging"],
                           [Step(*step) for step in content["steps"]], list(content["folders"]))
@@ -121,25 +125,55 @@ def finish(folder: Path, journal: Journal) -> None:
     (folder / JOURNAL_NAME).unlink(missing_ok=True)
 
 
-def roll_forward(folder: Path, journal: Journal, *, strict: bool) -> list[str]:
-    """Make every move the journal records that is not made yet; return the names kept.
+def _kept_copy(folder: Path, journal: Journal, part: str, name: str) -> Path | None:
+    """The staged (``part="new"``) or backed-up (``"old"``) copy of ``name``, if it is a
+    plain file reached through real folders of the temporary folder (``None`` if not:
+    moved already, or something there is a link, which is never followed)."""
+    root = folder / journal.staging / part
+    for level in (folder / journal.staging, root):
+        if os.path.islink(level) or not level.is_dir():
+            return None
+    path = root / name
+    if entry_problem(root, name, manifest_ok=True) or os.path.islink(path) \
+            or not path.is_file():
+        return None
+    return path
+
+
+def _content(target: Path) -> str | None:
+    """The SHA-256 of ``target`` if it is a plain file; ``None`` if there is nothing; a
+    mark that matches no content if it is anything else (a link, a folder)."""
+    if not os.path.lexists(target):
+        return None
+    return file_sha256(target) or "not a plain file"
+
+
+def roll_forward(folder: Path, journal: Journal, *, strict: bool) -> tuple[int, list[str]]:
+    """Make every move the journal records that is not made yet.
 
     A target that holds neither its old nor its new content was changed by someone
     else: it is kept (its name returned) or, if ``strict``, the build stops.
+
+    Returns
+    -------
+    moved : int
+        How many files were moved into place or deleted now.
+    kept : list of str
+        The names kept because they changed.
     """
-    staged_root = folder / journal.staging / "new"
     for name in journal.folders:
         (folder / name).mkdir(exist_ok=True)
-    kept = []
+    kept, moved = [], 0
     for step in journal.steps:
         target = folder / step.name
-        now = file_sha256(target) if os.path.lexists(target) else None
-        staged = staged_root / step.name
+        now = _content(target)
         if step.new is None:
             if now is not None and now == step.old:
                 target.unlink()
+                moved += 1
             continue
-        if not os.path.lexists(staged):
+        staged = _kept_copy(folder, journal, "new", step.name)
+        if staged is None:
             continue  # moved already
         if now != step.old and now != step.new:
             if strict:
@@ -148,23 +182,23 @@ def roll_forward(folder: Path, journal: Journal, *, strict: bool) -> list[str]:
             kept.append(step.name)
             continue
         os.replace(staged, target)
-    return kept
+        moved += 1
+    return moved, kept
 
 
 def roll_back(folder: Path, journal: Journal) -> int:
     """Put back every old file the journal records; return how many were put back."""
-    backups = folder / journal.staging / "old"
     restored = 0
     for step in reversed(journal.steps):
         target = folder / step.name
-        now = file_sha256(target) if os.path.lexists(target) else None
+        now = _content(target)
+        backup = _kept_copy(folder, journal, "old", step.name) if step.old else None
         if step.old is None:
             if now is not None and now == step.new:
                 target.unlink()
                 restored += 1
-        elif os.path.lexists(backups / step.name) and now != step.old and (
-                now is None or now == step.new):
-            os.replace(backups / step.name, target)
+        elif backup is not None and now != step.old and (now is None or now == step.new):
+            os.replace(backup, target)
             restored += 1
     for name in reversed(journal.folders):
         try:
@@ -193,7 +227,7 @@ def recover(folder: Path) -> str | None:
     journal = read_journal(folder)
     if journal is None:
         return None
-    what = f"recovered {shown(folder)}: a run of {journal.tool} was killed"
+    what = f"recovered {shown(folder)}: a run of {shown(journal.tool)} was killed"
     if journal.state == "staging":
         finish(folder, journal)
         return (f"{what} before it changed anything; its temporary folder {journal.staging} "
@@ -203,8 +237,8 @@ def recover(folder: Path) -> str | None:
         finish(folder, journal)
         return (f"{what} while undoing a failed build; it is now undone ({restored} file(s) "
                 f"put back)")
-    kept = roll_forward(folder, journal, strict=False)
+    moved, kept = roll_forward(folder, journal, strict=False)
     finish(folder, journal)
-    note = f"; kept as they are, changed since: {', '.join(map(shown, kept))}" if kept else ""
-    return (f"{what} while moving its files into place; the move is now complete, so the "
-            f"folder holds that run's files{note}")
+    note = f"; kept as they are, changed since: {summarise(kept)}" if kept else ""
+    return (f"{what} while moving its files into place; the move is now finished ({moved} "
+            f"more file(s) moved), so the folder holds that run's files{note}")

@@ -27,6 +27,8 @@ MANIFEST_NAME = ".lqe-manifest.json"
 MANIFEST_FORMAT = 1
 #: What a name in an output folder may not start with: the tools' own files and folders.
 RESERVED_PREFIX = ".lqe-"
+#: The largest manifest the tools read (bytes): one of thousands of files is < 1 MB.
+MAX_MANIFEST_BYTES = 64 * 2**20
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 
 
@@ -128,6 +130,10 @@ def read_manifest(out_dir: Path | str) -> Manifest | None:
     unreadable = (f"{path} is not a manifest the course tools can read (%s); nothing was "
                   f"changed: move the folder {out_dir} away or write elsewhere")
     try:
+        size = os.path.getsize(path)
+        if size > MAX_MANIFEST_BYTES:
+            raise OutputFolderError(unreadable % f"{size} bytes, more than a manifest's "
+                                                 f"{MAX_MANIFEST_BYTES}")
         content = json.loads(path.read_bytes().decode("utf-8"))
     except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
         reason = error.strerror if isinstance(error, OSError) else (

@@ -36,6 +36,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     import nbformat
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import shown
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
     from lqe_helpers.authoring.task_cells import (
@@ -378,7 +379,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="folder for marking-guide.md (default: build/marking-guide)")
 
     def command(args: argparse.Namespace) -> int:
-        print(build_marking_guide(args.source, args.out))
+        print(shown(build_marking_guide(args.source, args.out)))
         return 0
 
     return run_command(parser, command, argv)

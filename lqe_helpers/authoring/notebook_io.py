@@ -133,20 +133,26 @@ def source_notebooks(source_dir: Path | str) -> list[Path]:
     Raises
     ------
     ValueError
-        If ``source_dir`` is not a folder or holds no notebook, or if a notebook there is
-        a symbolic link (the tools never follow a link to a source: it could be any file).
+        If ``source_dir`` is not a folder or holds no notebook, or if a ``*.ipynb`` there
+        is a symbolic link (the tools never follow a link to a source: it could be any
+        file) or not a file at all (a folder, a fifo: never silently skipped).
     """
     source_dir = Path(source_dir)
     if not source_dir.is_dir():
         raise ValueError(f"source_dir must be an existing folder, got {shown(source_dir)}")
-    notebooks = sorted(path for path in source_dir.glob("*.ipynb")
-                       if path.is_file() or path.is_symlink())
+    notebooks = sorted(source_dir.glob("*.ipynb"))
     links = [path.name for path in notebooks if path.is_symlink()]
     if links:
         raise NotebookFileError(
             f"{summarise(links)} in {shown(source_dir)} "
             f"{'is a symbolic link' if len(links) == 1 else 'are symbolic links'}; the tools "
             f"read only real notebook files: put the notebook itself there")
+    odd = [path.name for path in notebooks if not path.is_file()]
+    if odd:
+        raise NotebookFileError(
+            f"{summarise(odd)} in {shown(source_dir)} "
+            f"{'is' if len(odd) == 1 else 'are'} named like a notebook but not a file (a "
+            f"folder, a fifo, a device); rename or remove {'it' if len(odd) == 1 else 'them'}")
     if not notebooks:
         raise ValueError(f"source_dir must hold at least one .ipynb file, got none in "
                          f"{shown(source_dir)}")

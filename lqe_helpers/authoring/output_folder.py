@@ -66,20 +66,22 @@ def check_out_dir(source_dir: Path | str, out_dir: Path | str) -> None:
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
     if out_dir.exists() and not out_dir.is_dir():
-        raise OutputFolderError(f"the output folder {out_dir} is a file; give a folder")
+        raise OutputFolderError(f"the output folder {shown(out_dir)} is a file; give a folder")
     source_real = Path(os.path.realpath(source_dir))
     out_real = Path(os.path.realpath(out_dir))
     for folder in _ancestors(out_real):
         if folder.exists() and _same(folder, source_real):
             where = "is" if folder == out_real else "lies inside"
             raise OutputFolderError(
-                f"the output folder {out_dir} {where} the source folder {source_dir}; "
+                f"the output folder {shown(out_dir)} {where} the source folder "
+                f"{shown(source_dir)}; "
                 f"write the build somewhere else")
     if out_real.exists():
         for folder in _ancestors(source_real):
             if folder.exists() and _same(folder, out_real):
                 raise OutputFolderError(
-                    f"the output folder {out_dir} contains the source folder {source_dir}, "
+                    f"the output folder {shown(out_dir)} contains the source folder "
+                    f"{shown(source_dir)}, "
                     f"so a build could replace or delete source files; write it somewhere else")
 
 
@@ -89,10 +91,15 @@ def check_output_location(out_dir: Path | str, sources: Sequence[Path | str] = (
     Raises
     ------
     OutputFolderError
-        If ``out_dir`` is a file, a broken symbolic link, or is, contains or lies inside
-        one of ``sources`` (:func:`check_out_dir`).
+        If ``out_dir`` is a file, a broken symbolic link, starts with an unexpanded ``~``,
+        or is, contains or lies inside one of ``sources`` (:func:`check_out_dir`).
     """
     out_dir = Path(out_dir)
+    if out_dir.parts and out_dir.parts[0].startswith("~"):
+        raise OutputFolderError(
+            f"the output folder {shown(out_dir)} starts with '~', which no shell expanded "
+            f"(was it quoted?); a folder named like that is too easily taken for a home "
+            f"folder: give the path itself (e.g. $HOME/...)")
     if out_dir.exists() and not out_dir.is_dir():
         raise OutputFolderError(f"the output folder {shown(out_dir)} is a file; give a folder")
     if os.path.islink(out_dir) and not out_dir.exists():
@@ -360,7 +367,7 @@ def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
         nothing is deleted then.
     """
     out_dir = Path(out_dir)
-    if not out_dir.is_dir() or out_dir.is_symlink():
+    if not out_dir.is_dir():
         return [], []
     removed: list[Path] = []
     with FolderLock(out_dir):
@@ -377,7 +384,7 @@ def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
             for folder in sorted(folders, key=lambda path: len(path.parts), reverse=True):
                 if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
                     folder.rmdir()
-    if manifest is not None and not any(out_dir.iterdir()):
+    if manifest is not None and not out_dir.is_symlink() and not any(out_dir.iterdir()):
         out_dir.rmdir()
     kept = sorted(path for path in out_dir.rglob("*") if not path.is_dir()) \
         if out_dir.exists() else []

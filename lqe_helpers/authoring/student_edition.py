@@ -70,6 +70,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     # what it wrote, and what build_student_edition raises.
     from lqe_helpers.authoring.errors import OutputFolderError as OutputFolderError
     from lqe_helpers.authoring.errors import OutputWriteError as OutputWriteError
+    from lqe_helpers.authoring.errors import shown
     from lqe_helpers.authoring.manifest import MANIFEST_NAME as MANIFEST_NAME
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
@@ -372,7 +373,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def command(args: argparse.Namespace) -> int:
         for path in build_student_edition(
                 args.source, args.out, allow_without_solutions=args.allow_without_solutions):
-            print(path)
+            print(shown(path))
         return 0
 
     return run_command(parser, command, argv)

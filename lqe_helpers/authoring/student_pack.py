@@ -353,8 +353,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                              "instead of refusing")
 
     def command(args: argparse.Namespace) -> int:
-        print(build_student_pack(args.root, args.out,
-                                 allow_without_solutions=args.allow_without_solutions))
+        print(shown(build_student_pack(args.root, args.out,
+                                 allow_without_solutions=args.allow_without_solutions)))
         return 0
 
     return run_command(parser, command, argv)

@@ -200,7 +200,7 @@ class Transaction:
         self.journal.steps = [step for step in self.journal.steps if step.name not in changed]
         self.journal.state = "committing"
         write_journal(self.folder, self.journal)
-        kept = roll_forward(self.folder, self.journal, strict=strict)
+        _, kept = roll_forward(self.folder, self.journal, strict=strict)
         return changed + kept
 
     def finish(self) -> None:
