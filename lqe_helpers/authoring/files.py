@@ -62,7 +62,10 @@ def _temporary_copy(path: Path, data: bytes) -> Path:
     The file gets the permission bits of ``path`` if it exists (else the umask's), and
     is flushed to disk. On failure nothing is left behind.
     """
-    fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-tmp")
+    try:
+        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-tmp")
+    except OSError as error:  # name the file being written, not a temporary name
+        raise OSError(error.errno, error.strerror, str(path)) from error
     temporary = Path(name)
     try:
         os.fchmod(fd, mode_for(path))

@@ -118,6 +118,10 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
                               if path.parent.is_dir()}):
             held.enter_context(FolderLock(folder))
         checked = _check_paths(paths)
+        for folder in {path.parent for path in checked}:
+            if not os.access(folder, os.W_OK | os.X_OK):
+                raise NotebookFileError(f"cannot save into {shown(folder)}: it is read-only "
+                                        f"for you; nothing was run")
         results: dict[Path, bytes] = {}
         for path, state in checked.items():
             if log:

@@ -92,7 +92,8 @@ def check_output_location(out_dir: Path | str, sources: Sequence[Path | str] = (
     ------
     OutputFolderError
         If ``out_dir`` is a file, a broken symbolic link, starts with an unexpanded ``~``,
-        or is, contains or lies inside one of ``sources`` (:func:`check_out_dir`).
+        is, contains or lies inside one of ``sources`` (:func:`check_out_dir`), or is (or
+        would be made in) a folder this process may not write (a read-only file system).
     """
     out_dir = Path(out_dir)
     if out_dir.parts and out_dir.parts[0].startswith("~"):
@@ -106,6 +107,11 @@ def check_output_location(out_dir: Path | str, sources: Sequence[Path | str] = (
         raise OutputFolderError(f"the output folder {shown(out_dir)} is a broken symbolic link")
     for source in sources:
         check_out_dir(source, out_dir)
+    existing = next(folder for folder in [out_dir.absolute(), *out_dir.absolute().parents]
+                    if folder.exists())
+    if not os.access(existing, os.W_OK | os.X_OK):
+        raise OutputFolderError(f"cannot write into {shown(out_dir)}: {shown(existing)} is "
+                                f"read-only for you; nothing was done")
 
 
 def check_output_names(names: Iterable[str]) -> list[str]:
