@@ -11,6 +11,7 @@ import json
 import os
 import resource
 import subprocess
+from pathlib import Path
 
 import pytest
 from tools_helpers import (
@@ -209,3 +210,68 @@ def test_a_time_limit_near_the_largest_float_is_one_line(tmp_path, value):
     assert result.stderr == (f"error: argument --timeout: must be a number of seconds > 0, got "
                              f"{value!r} (at most 604800, a week); see python -m "
                              f"lqe_helpers.authoring.notebook_runner --help\n")
+
+
+# --- read-only folders: refused before anything runs ----------------------------------------------
+
+def test_a_read_only_output_folder_is_refused_before_any_notebook_runs(tmp_path, monkeypatch):
+    from lqe_helpers.authoring import handouts
+
+    source = tmp_path / "notebooks"
+    write_notebook(source / "01_a.ipynb")
+    out = tmp_path / "out"
+    out.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda path, mode, **kwargs: (
+        False if Path(path) == out else real_access(path, mode, **kwargs)))
+
+    def must_not_run(*args, **kwargs):
+        raise AssertionError("a notebook ran although nothing could be written")
+
+    monkeypatch.setattr(handouts, "execute_notebook", must_not_run)
+    with pytest.raises(OutputFolderError, match=f"cannot write into {out}: {out} is read-only "
+                                                f"for you; nothing was done"):
+        handouts.build_handouts(source, out, mathjax_url="")
+
+
+def test_the_runner_refuses_a_read_only_folder_before_running(tmp_path, monkeypatch):
+    from lqe_helpers.authoring import notebook_runner
+    from lqe_helpers.authoring.errors import NotebookFileError
+
+    path = write_notebook(tmp_path / "01.ipynb")
+    real_access = os.access
+    monkeypatch.setattr(os, "access", lambda folder, mode, **kwargs: (
+        False if Path(folder) == tmp_path else real_access(folder, mode, **kwargs)))
+    monkeypatch.setattr(notebook_runner, "execute_notebook", lambda *args: pytest.fail("ran"))
+    with pytest.raises(NotebookFileError, match=f"cannot save into {tmp_path}: it is read-only"):
+        notebook_runner.run_notebooks([path])
+
+
+@pytest.fixture
+def read_only_mount(tmp_path):
+    """A folder on a real read-only bind mount (root with mount rights only; else skipped)."""
+    folder = tmp_path / "read-only"
+    folder.mkdir()
+    (folder / "kept.txt").write_text("kept")
+    mounted = subprocess.run(["mount", "--bind", str(folder), str(folder)], capture_output=True,
+                             check=False).returncode == 0
+    if not mounted:
+        pytest.skip("cannot bind-mount here (needs root and mount rights)")
+    try:
+        if subprocess.run(["mount", "-o", "remount,ro,bind", str(folder)], capture_output=True,
+                          check=False).returncode != 0:
+            pytest.skip("cannot remount read-only here")
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=False)
+
+
+def test_a_real_read_only_file_system(tmp_path, read_only_mount):
+    source = tmp_path / "notebooks"
+    write_notebook(source / "01_a.ipynb")
+    for out in (read_only_mount, read_only_mount / "new"):
+        result = run_tool("student_edition", "--source", str(source), "--out", str(out))
+        assert result.returncode == 1
+        assert result.stderr == (f"error: cannot write into {out}: {read_only_mount} is "
+                                 f"read-only for you; nothing was done\n")
+    assert sorted(path.name for path in read_only_mount.iterdir()) == ["kept.txt"]
