@@ -254,3 +254,53 @@ def test_the_notebook_runner_killed_while_saving_recovers_on_its_next_run(tmp_pa
     assert result.returncode == 0, result.stderr
     assert result.stderr.startswith(f"warning: recovered {tmp_path}: a run of notebook_runner")
     assert sorted(path.name for path in tmp_path.iterdir()) == ["01.ipynb", "02.ipynb"]
+
+
+def test_the_recovery_never_overwrites_a_file_changed_after_the_kill(tmp_path, states):
+    _, _, count = states
+    out = tmp_path / "out"
+    harness(WRITE.format(out=str(out), files=OLD), 10**9)
+    journal_written = 4  # kill right after the journal of the moves, before the first move
+    for n in range(journal_written, count):
+        shutil.rmtree(out)
+        harness(WRITE.format(out=str(out), files=OLD), 10**9)
+        assert harness(WRITE.format(out=str(out), files=NEW), n).returncode == -9
+        journal = out / ".lqe-journal.json"
+        if journal.exists() and '"committing"' in journal.read_text() and \
+                (out / "a.html").read_text() == "a, old":
+            break
+    else:
+        pytest.fail("no kill point between the journal and the first move")
+    (out / "a.html").write_text("edited by hand after the crash")
+    [line] = recovered(out)
+    assert "kept as they are, changed since: a.html" in line
+    assert (out / "a.html").read_text() == "edited by hand after the crash"
+    assert (out / "sub" / "c.html").read_text() == "c, new"
+
+
+def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
+    """A real SIGINT in the middle of the moves: the build completes, then the interrupt."""
+    out = tmp_path / "out"
+    code = textwrap.dedent(f"""
+        import os, signal
+        from lqe_helpers.authoring.output_folder import write_output_folder
+        write_output_folder({str(out)!r}, {OLD!r}, tool="handouts")
+        real, calls = os.replace, []
+        def replace(*args, **kwargs):
+            calls.append(args)
+            if len(calls) == 4:
+                signal.raise_signal(signal.SIGINT)  # Ctrl-C, between two moves
+            return real(*args, **kwargs)
+        os.replace = replace
+        try:
+            write_output_folder({str(out)!r}, {NEW!r}, tool="handouts")
+        except KeyboardInterrupt:
+            print("interrupted after", len(calls), "moves")
+    """)
+    result = subprocess.run(python_command("-c", code), env=tools_environment(),
+                            capture_output=True, text=True, timeout=120, check=False)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.startswith("interrupted after")
+    assert int(result.stdout.split()[2]) > 4  # every move was made first
+    assert {name: data.decode() for name, data in snapshot(out).items()
+            if isinstance(data, bytes) and name.endswith(".html")} == NEW
