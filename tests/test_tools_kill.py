@@ -109,6 +109,7 @@ def states(tmp_path_factory) -> tuple[dict, dict, int]:
     return snapshot(old), snapshot(new), count
 
 
+@pytest.mark.slow
 def test_a_build_killed_at_every_step_is_recovered(tmp_path, states):
     old, new, count = states
     assert count > 10
@@ -147,6 +148,7 @@ def test_the_recovery_says_what_it_did(tmp_path, states):
     assert recovered(out) == []  # nothing left to do
 
 
+@pytest.mark.slow
 def test_a_ctrl_c_at_every_step_leaves_the_folder_as_it_was(tmp_path, states):
     """An interrupt the process sees is undone at once; once every file is in place
     (removing the temporary folder), the build is complete and the next run tidies up."""
@@ -169,6 +171,7 @@ def test_a_ctrl_c_at_every_step_leaves_the_folder_as_it_was(tmp_path, states):
     assert first_new > count / 2
 
 
+@pytest.mark.slow
 def test_a_new_folder_killed_at_every_step(tmp_path):
     code = WRITE.format(out=str(tmp_path / "probe"), files=NEW)
     count = operations(code)
@@ -206,6 +209,7 @@ def test_student_edition_killed_then_run_again_from_the_command_line(tmp_path):
                                                             "02_b.ipynb"]
 
 
+@pytest.mark.slow
 def test_atomic_write_many_killed_at_every_step(tmp_path):
     """The runner's save: each folder wholly old or wholly new after the next run."""
     first, second = tmp_path / "one", tmp_path / "two"

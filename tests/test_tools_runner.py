@@ -196,6 +196,7 @@ def test_the_merge_of_one_long_line_takes_linear_time():
     assert time.perf_counter() - begin < 1.0  # nbclient's regex: hours
 
 
+@pytest.mark.slow
 @pytest.mark.kernel
 def test_a_one_megabyte_line_is_saved_in_seconds(tmp_path):
     path = code_notebook(tmp_path / "01_long.ipynb",
@@ -208,6 +209,7 @@ def test_a_one_megabyte_line_is_saved_in_seconds(tmp_path):
     assert output["text"] == "x" * 1_000_000 + "\n100%\n"
 
 
+@pytest.mark.slow
 @pytest.mark.kernel
 def test_handouts_of_a_one_megabyte_line_are_built_in_seconds(tmp_path):
     source = tmp_path / "notebooks"
