@@ -167,7 +167,7 @@ def _trial() -> dict[str, object]:
     mistakes = {
         "vision": {
             "it is the fused filter's estimate: vision_positions comes from the filter given "
-            "vision alone (column 0 of y, row 0 of C, R[:1, :1])": fused,
+            "vision alone (column 0 of y, row 0 of C, the top-left entry of R)": fused,
             "it is the filter run on proprioception's readings (column 1 of y): vision's "
             "readings are column 0": engine_positions(y[:, 1:], [sigma_p]),
             velocity: engine_positions(y[:, :1], [sigma_v], 1),
@@ -178,7 +178,8 @@ def _trial() -> dict[str, object]:
             "it is the vision-only filter's estimate: fused_positions comes from the filter "
             "given both senses (all of y, C and R)": vision,
             "the two readings were averaged and filtered as one sense with vision's R: the "
-            "filter of both senses needs no averaging; give it y (n, 2) with your C and R":
+            "filter of both senses needs no averaging; give it both columns of the readings "
+            "with your C and R":
                 engine_positions(y.mean(axis=1, keepdims=True), [sigma_v]),
             velocity: engine_positions(y, [sigma_v, sigma_p], 1),
             sigma_for_variance: engine_positions(y, root["fused"]),

@@ -80,8 +80,8 @@ def _fits() -> dict[str, dict[str, metrics.SinusoidFit]]:
 
         found[name] = {
             "right": fit(clean.positions),
-            "the fit includes the start-up: fit only the samples from burn_in on "
-            "(times[burn_in:] and positions[burn_in:])": fit(clean.positions, 0),
+            "the fit includes the start-up: fit only the samples after the burn-in, times and "
+            "positions alike": fit(clean.positions, 0),
             "it is the fit of the noisy trial's estimate (Task 2): feed the filter the true "
             "position itself, without noise": fit(noisy),
             "it is the fit of the readings (the true path itself), not of the filter's "
@@ -165,8 +165,8 @@ def check_settled_variances(theory_vision: float, theory_fused: float) -> None:
         right = _position_variance(sensors)
         key = "vision_after" if kind == "vision only" else "fused_after"
         mistakes = {
-            "it is [P∞]pp, the variance of the one-step prediction (steady_state(...)."
-            "covariance): the estimate's own variance is in estimate_covariance":
+            "it is [P∞]pp, the variance of the one-step prediction (the steady state's "
+            "covariance): the estimate's own variance is its estimate_covariance":
                 _position_variance(sensors, prediction=True),
             "it is a standard deviation (cm): the variance is its square (cm²)": np.sqrt(right),
             "R holds σ (cm) where the variance σ² (cm²) belongs":
@@ -276,7 +276,7 @@ def check_settled_filter(time_constants: np.ndarray, predicted_amplitude: float,
     if np.iscomplexobj(time_constants):
         raise CheckFailed(
             "time_constants holds complex numbers: the log of a complex pole is complex. "
-            "Take the modulus |λ| of each pole (np.abs) before the log")
+            "Take the modulus |λ| of each pole before the log")
     try:
         raw = np.asarray(time_constants, dtype=float)
     except (TypeError, ValueError):
@@ -300,8 +300,8 @@ def check_settled_filter(time_constants: np.ndarray, predicted_amplitude: float,
                   _taus(settled.closed_loop, log=np.log10),
               "M is A − K∞ C: the correction acts on the prediction A ẑ, so M = (I − K∞ C) A":
                   _taus(m.A - gain @ m.C),
-              "they are the fused filter's: the task asks for the vision-only filter "
-              "(C[:1], R[:1, :1])": _taus(fused.closed_loop),
+              "they are the fused filter's: the task asks for the vision-only filter (row 0 "
+              "of C, the top-left entry of R)": _taus(fused.closed_loop),
               "they are the approximation Δt / (1 − |λ|): use −Δt / ln|λ|": np.sort(
                   DEFAULT.dt / (1 - np.abs(settled.poles)))[::-1],
           })
@@ -323,8 +323,8 @@ def check_settled_filter(time_constants: np.ndarray, predicted_amplitude: float,
     judge("predicted_lead", predicted_lead, response.lead[0], THEORY_RTOL, unit="s",
           what="the lead of the settled response",
           mistakes={
-              "it is the phase arg H (rad): the lead in s is the phase over 2π f "
-              "(response.lead)": response.phase[0],
+              "it is the phase arg H (rad): the lead in s is the phase divided by 2π f":
+                  response.phase[0],
               "it is in ms: the task asks for seconds": 1000 * response.lead[0],
               "the sign is reversed: a positive lead means the estimate runs ahead":
                   -response.lead[0],
