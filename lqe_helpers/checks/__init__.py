@@ -17,7 +17,8 @@ One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exp
 every ``check_…`` and the tolerances:
 
 - ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
+  (02), ``fusion`` (03, with ``fusion_further``), ``noisier_proprioception`` (04),
+  ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -28,7 +29,16 @@ every ``check_…`` and the tolerances:
 from .background import check_covariance_step, check_transition_matrix
 from .bias import check_bias_model
 from .delay import check_compensation, check_delay_difference, check_delay_mse
-from .fusion import check_fusion
+from .fusion import check_fusion, check_fusion_difference, check_fusion_trial
+from .fusion_further import (
+    THEORY_RTOL,
+    check_equivalent_sensor,
+    check_gain_shares,
+    check_halving,
+    check_noise_free_fits,
+    check_settled_filter,
+    check_settled_variances,
+)
 from .initial_covariance import check_convergence_time, check_initial_covariance
 from .machinery import (
     FUNCTION_RTOL,
@@ -48,6 +58,7 @@ __all__ = [
     "MATRIX_RTOL",
     "MSE_RTOL",
     "SEED",
+    "THEORY_RTOL",
     "TIME_ATOL",
     "CheckFailed",
     "check_bias_model",
@@ -56,11 +67,19 @@ __all__ = [
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
+    "check_equivalent_sensor",
     "check_filter",
     "check_fusion",
+    "check_fusion_difference",
+    "check_fusion_trial",
+    "check_gain_shares",
+    "check_halving",
     "check_initial_covariance",
     "check_mse",
+    "check_noise_free_fits",
     "check_paired_difference",
+    "check_settled_filter",
+    "check_settled_variances",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
