@@ -309,6 +309,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
 def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] | None,
             hint: str, shape_hint: str, rerun: str) -> StudentCodeError:
     """The StudentCodeError reporting ``error``, raised by the student's function."""
+    if isinstance(error, StudentCodeError):  # already one line for the student (a stand-in's)
+        return error
     if isinstance(error, NotImplementedError):
         return NotWrittenYet(
             f"{name} is not written yet: {NOT_WRITTEN_ADVICE.format(rerun=rerun)}")
