@@ -17,7 +17,8 @@ One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exp
 every ``check_…`` and the tolerances:
 
 - ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
+  (02), ``fusion`` (03), ``noisier_proprioception`` (04, with ``misjudged_noise``),
+  ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -39,6 +40,14 @@ from .machinery import (
     TIME_ATOL,
     CheckFailed,
 )
+from .misjudged_noise import check_assumed_sweep, check_misjudged, check_misjudged_nis
+from .noisier_proprioception import (
+    check_noisier_difference,
+    check_noisier_theory,
+    check_noisier_trial,
+    check_proprioception_sweep,
+    check_sweep_reading,
+)
 from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
 
@@ -50,6 +59,7 @@ __all__ = [
     "SEED",
     "TIME_ATOL",
     "CheckFailed",
+    "check_assumed_sweep",
     "check_bias_model",
     "check_compensation",
     "check_convergence_time",
@@ -59,8 +69,15 @@ __all__ = [
     "check_filter",
     "check_fusion",
     "check_initial_covariance",
+    "check_misjudged",
+    "check_misjudged_nis",
     "check_mse",
+    "check_noisier_difference",
+    "check_noisier_theory",
+    "check_noisier_trial",
     "check_paired_difference",
+    "check_proprioception_sweep",
+    "check_sweep_reading",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
