@@ -17,7 +17,8 @@ One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exp
 every ``check_…`` and the tolerances:
 
 - ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03, with ``fusion_further``), ``noisier_proprioception`` (04),
+  (02), ``fusion`` (03, with ``fusion_further``), ``noisier_proprioception`` (04, with
+  ``misjudged_noise``),
   ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
@@ -49,6 +50,14 @@ from .machinery import (
     TIME_ATOL,
     CheckFailed,
 )
+from .misjudged_noise import check_assumed_sweep, check_misjudged, check_misjudged_nis
+from .noisier_proprioception import (
+    check_noisier_difference,
+    check_noisier_theory,
+    check_noisier_trial,
+    check_proprioception_sweep,
+    check_sweep_reading,
+)
 from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
 
@@ -61,6 +70,7 @@ __all__ = [
     "THEORY_RTOL",
     "TIME_ATOL",
     "CheckFailed",
+    "check_assumed_sweep",
     "check_bias_model",
     "check_compensation",
     "check_convergence_time",
@@ -75,11 +85,18 @@ __all__ = [
     "check_gain_shares",
     "check_halving",
     "check_initial_covariance",
+    "check_misjudged",
+    "check_misjudged_nis",
     "check_mse",
     "check_noise_free_fits",
+    "check_noisier_difference",
+    "check_noisier_theory",
+    "check_noisier_trial",
     "check_paired_difference",
+    "check_proprioception_sweep",
     "check_settled_filter",
     "check_settled_variances",
+    "check_sweep_reading",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
