@@ -16,7 +16,8 @@ the student's value with :func:`judging.judge` against a catalogue of likely mis
 One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
 every ``check_…`` and the tolerances:
 
-- ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
+- ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
+  ``vision_further`` for its Going further), ``initial_covariance``
   (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
@@ -41,6 +42,13 @@ from .machinery import (
 )
 from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
+from .vision_further import (
+    check_nis,
+    check_sampling_ratio,
+    check_steady_state,
+    check_systematic_error,
+)
+from .vision_smoothers import check_smoother, check_smoother_comparison
 
 __all__ = [
     "FUNCTION_RTOL",
@@ -60,7 +68,13 @@ __all__ = [
     "check_fusion",
     "check_initial_covariance",
     "check_mse",
+    "check_nis",
     "check_paired_difference",
+    "check_sampling_ratio",
+    "check_smoother",
+    "check_smoother_comparison",
+    "check_steady_state",
+    "check_systematic_error",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
