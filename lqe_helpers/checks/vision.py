@@ -6,6 +6,10 @@
   recomputed from the scenario's draw with the engine;
 - :func:`check_vision_difference` (Task 3): the paired raw − filtered difference over
   the Monte Carlo runs, recomputed with :func:`lqe_helpers.experiments.track`.
+
+:func:`monte_carlo` (Task 3's runs) and :func:`keyed` (a student's dict keyed by σ_v or
+Δt) serve the Going further checks too (:mod:`~lqe_helpers.checks.vision_smoothers`,
+:mod:`~lqe_helpers.checks.vision_further`).
 """
 
 from __future__ import annotations
