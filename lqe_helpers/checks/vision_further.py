@@ -22,7 +22,7 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from ..steady_state import steady_state
+from ..steady_state import SteadyState
 from .judging import judge, mse_mistakes
 from .machinery import MSE_RTOL, CheckFailed, passed, tolerance_text
 from .vision import SIGMAS_V, keyed, monte_carlo
@@ -147,9 +147,9 @@ def check_systematic_error(amplitude: dict[float, float], lead_ms: dict[float, f
 # Part 3: the filter's confidence, with and without the true path
 # ------------------------------------------------------------------------------------------
 
-def _steady(r_variance: float):
-    return steady_state(DEFAULT.A, np.array([[1.0, 0.0, 0.0]]), DEFAULT.Q,
-                        np.array([[r_variance]]))
+def _steady(r_variance: float) -> SteadyState:
+    """The steady state of vision alone with R = [[r_variance]] (cm²)."""
+    return experiments.filter_model(DEFAULT, sigmas=[np.sqrt(r_variance)]).steady_state()
 
 
 def _coverage(errors: np.ndarray, limits: np.ndarray) -> float:
@@ -193,7 +193,8 @@ def check_steady_state(forecast: dict[float, float], coverage: dict[float, float
     """Check part 3: [P̂∞]pp, the filter's forecast of its MSE, and its ±2σ coverage.
 
     Recomputed from the task's inputs before looking at the student's: the steady state
-    of eq. (5) with R = [[σ_v²]] (:func:`lqe_helpers.steady_state.steady_state`), and the
+    of eq. (5) with R = [[σ_v²]] (:func:`lqe_helpers.steady_state.steady_state` of
+    :func:`lqe_helpers.experiments.filter_model`), and the
     percentage of samples after the burn-in, over Task 3's runs, where |estimate −
     truth| <= 2 √(the filter's position variance); each within :data:`MSE_RTOL` relative.
 
