@@ -110,8 +110,15 @@ def test_check_smoother_wants_time_on_the_last_axis() -> None:
 
 
 def test_check_smoother_refuses_the_packs_own_and_a_stub() -> None:
-    assert_fails("the pack's own smoother", checks.check_smoother,
+    assert_fails("exponential_smoother runs the pack's own "
+                 "lqe_helpers.smoothing.exponential_smoother", checks.check_smoother,
                  smoothing.exponential_smoother)
+
+    def my_smoother(y, alpha):
+        return smoothing.exponential_smoother(y, alpha)
+
+    assert_fails("my_smoother runs the pack's own lqe_helpers.smoothing.exponential_smoother",
+                 checks.check_smoother, my_smoother)
 
     def my_smoother(y, alpha):
         raise NotImplementedError
