@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -37,8 +38,21 @@ SAMPLING_SIGMA_V = 1.5
 _TRUTH = DEFAULT.truth[:, 0]
 
 
-def _other(column: int) -> str:
-    return f"it is the value for σ_v = {SIGMAS_V[1 - column]:g} cm"
+def _judge_each_sigma(values: dict[str, dict[float, object]], units: dict[str, str],
+                      table: Callable[[int], dict[str, dict[str, object]]]) -> None:
+    """Judge each of the student's dicts (name → values by σ_v) against ``table``.
+
+    ``table(column)`` gives, for σ_v = SIGMAS_V[column], each name's right value and its
+    likely mistakes; the value of the other σ_v is one more likely mistake.
+    """
+    for column, sigma in enumerate(SIGMAS_V):
+        right, other = table(column), table(1 - column)
+        for name, by_sigma in values.items():
+            judge(f"{name}[{sigma:g}]", by_sigma[sigma], right[name]["right"], MSE_RTOL,
+                  unit=units[name], what="the value recomputed from the task's inputs",
+                  mistakes={**right[name]["mistakes"],
+                            f"it is the value for σ_v = {SIGMAS_V[1 - column]:g} cm":
+                                other[name]["right"]})
 
 
 # ------------------------------------------------------------------------------------------
@@ -132,12 +146,7 @@ def check_systematic_error(amplitude: dict[float, float], lead_ms: dict[float, f
              "systematic": (systematic, "systematic parts of the MSE (cm²)", "cm²"),
              "noise_part": (noise_part, "noise parts of the MSE (cm²)", "cm²")}
     values = {name: keyed(value, name, what) for name, (value, what, _) in given.items()}
-    for column, sigma in enumerate(SIGMAS_V):
-        right, other = _split(column), _split(1 - column)
-        for name, (_, _, unit) in given.items():
-            judge(f"{name}[{sigma:g}]", values[name][sigma], right[name]["right"], MSE_RTOL,
-                  unit=unit, what="the value recomputed from the task's inputs",
-                  mistakes={**right[name]["mistakes"], _other(column): other[name]["right"]})
+    _judge_each_sigma(values, {name: unit for name, (_, _, unit) in given.items()}, _split)
     passed(f"the noise-free filter's fitted amplitude and lead and the systematic and noise "
            f"parts of the MSE at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match "
            f"the pack's engine on the task's draws to {tolerance_text(MSE_RTOL)} relative")
@@ -213,13 +222,7 @@ def check_steady_state(forecast: dict[float, float], coverage: dict[float, float
     """
     values = {"forecast": keyed(forecast, "forecast", "variances [P̂∞]pp (cm²)"),
               "coverage": keyed(coverage, "coverage", "percentages of samples")}
-    units = {"forecast": "cm²", "coverage": "%"}
-    for column, sigma in enumerate(SIGMAS_V):
-        right, other = _confidence(column), _confidence(1 - column)
-        for name in values:
-            judge(f"{name}[{sigma:g}]", values[name][sigma], right[name]["right"], MSE_RTOL,
-                  unit=units[name], what="the value recomputed from the task's inputs",
-                  mistakes={**right[name]["mistakes"], _other(column): other[name]["right"]})
+    _judge_each_sigma(values, {"forecast": "cm²", "coverage": "%"}, _confidence)
     passed(f"[P̂∞]pp and the ±2σ coverage at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} "
            f"cm match the pack's steady state and engine on Task 3's runs to "
            f"{tolerance_text(MSE_RTOL)} relative")
@@ -293,13 +296,7 @@ def check_nis(nis_mean: dict[float, float], runs_inside: dict[float, float]) -> 
     """
     values = {"nis_mean": keyed(nis_mean, "nis_mean", "mean NIS values"),
               "runs_inside": keyed(runs_inside, "runs_inside", "percentages of runs")}
-    units = {"nis_mean": "", "runs_inside": "%"}
-    for column, sigma in enumerate(SIGMAS_V):
-        right, other = _nis(column), _nis(1 - column)
-        for name in values:
-            judge(f"{name}[{sigma:g}]", values[name][sigma], right[name]["right"], MSE_RTOL,
-                  unit=units[name], what="the value recomputed from the task's inputs",
-                  mistakes={**right[name]["mistakes"], _other(column): other[name]["right"]})
+    _judge_each_sigma(values, {"nis_mean": "", "runs_inside": "%"}, _nis)
     passed(f"the mean NIS and the share of runs inside the 95 % band at σ_v = "
            f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match metrics.nis_test on Task 3's "
            f"runs to {tolerance_text(MSE_RTOL)} relative")
