@@ -16,10 +16,10 @@ the student's value with :func:`judging.judge` against a catalogue of likely mis
 One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
 every ``check_…`` and the tolerances:
 
-- ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03, with ``fusion_further``), ``noisier_proprioception`` (04, with
-  ``misjudged_noise``),
-  ``delay`` (05), ``bias`` (06);
+- ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
+  ``vision_further`` for its Going further), ``initial_covariance`` (02), ``fusion``
+  (03, with ``fusion_further``), ``noisier_proprioception`` (04, with
+  ``misjudged_noise``), ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -60,6 +60,13 @@ from .noisier_proprioception import (
 )
 from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
+from .vision_further import (
+    check_nis,
+    check_sampling_ratio,
+    check_steady_state,
+    check_systematic_error,
+)
+from .vision_smoothers import check_smoother, check_smoother_comparison
 
 __all__ = [
     "FUNCTION_RTOL",
@@ -88,15 +95,21 @@ __all__ = [
     "check_misjudged",
     "check_misjudged_nis",
     "check_mse",
+    "check_nis",
     "check_noise_free_fits",
     "check_noisier_difference",
     "check_noisier_theory",
     "check_noisier_trial",
     "check_paired_difference",
     "check_proprioception_sweep",
+    "check_sampling_ratio",
     "check_settled_filter",
     "check_settled_variances",
+    "check_smoother",
+    "check_smoother_comparison",
+    "check_steady_state",
     "check_sweep_reading",
+    "check_systematic_error",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
