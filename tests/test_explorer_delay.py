@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 import pytest
+import reference_loops as reference
 from explorer_checks import EXPLORER_SCENARIO, explorer_draw, fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 from matplotlib.text import Text
@@ -232,3 +233,128 @@ def test_scenario_delay_beyond_the_slider_range_is_refused():
     scenario = dataclasses.replace(DEFAULT, delay=0.6)
     with pytest.raises(ValueError, match=r"scenario\.delay .*\[0, 0\.5\] s, got 0\.6 s"):
         explore_delay(scenario)
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own my_filter and compensate drive the sliders (issue 15 §4)
+# ------------------------------------------------------------------------------------------
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A student's correct filter (the tests' plain eq. (5) loop)."""
+    return reference.lqe_filter(y, A, C, Q, R, z0, P0)
+
+
+def compensate(estimates, A, delay_steps):
+    """A student's correct eq. (7)."""
+    return reference.compensate(estimates, A, delay_steps)
+
+
+@pytest.mark.parametrize("delay", [0.1, 0.0, 0.37])
+def test_the_students_functions_draw_what_the_engine_draws(delay):
+    calls = {"filter": 0, "compensate": 0}
+
+    def counted_filter(y, A, C, Q, R, z0, P0):
+        calls["filter"] += 1
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    def counted_compensate(estimates, A, delay_steps):
+        calls["compensate"] += 1
+        return compensate(estimates, A, delay_steps)
+
+    theirs = explore_delay(filter=counted_filter, compensate=counted_compensate)
+    ours = explore_delay()
+    for explorer in (theirs, ours):
+        explorer.sliders["delay"].value = delay
+    assert theirs.problem == ""
+    mine, engine = _lines(theirs.figure), _lines(ours.figure)
+    assert set(mine) == set(engine)
+    for gid in engine:
+        np.testing.assert_allclose(mine[gid], engine[gid], rtol=0, atol=1e-9, err_msg=gid)
+    assert "(your counted_filter and your counted_compensate)" in theirs.numbers
+    assert "(the pack’s engine)" in ours.numbers
+    assert theirs.numbers.split(":", 1)[1] == ours.numbers.split(":", 1)[1]
+    # The filter ran once (a delay only shifts its output); the compensation at each draw.
+    assert calls == {"filter": 1, "compensate": 1 + (delay != DEFAULT.delay)}
+    _check_figure(theirs.figure, theirs.numbers, delay,
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
+
+
+def test_either_function_alone_is_named_with_the_pack_for_the_other():
+    assert "(your my_filter and the pack’s eq. (7))" in explore_delay(filter=my_filter).numbers
+    assert ("(the pack’s filter and your compensate)"
+            in explore_delay(compensate=compensate).numbers)
+
+
+def test_a_broken_compensate_shows_one_line_and_the_next_move_draws_again():
+    def compensate(estimates, A, delay_steps):
+        if delay_steps > 20:
+            return estimates[delay_steps:] @ np.linalg.matrix_power(A, delay_steps).T
+        return reference.compensate(estimates, A, delay_steps)
+
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem == ""
+    picture = explorer.png
+    explorer.sliders["delay"].value = 0.3
+    assert explorer.problem.startswith("compensate returned an array of shape (970, 3)")
+    assert explorer.numbers == explorer.problem and "\n" not in explorer.problem
+    assert explorer.png == picture                      # the last picture stays
+    explorer.sliders["delay"].value = 0.2
+    assert explorer.problem == ""
+    _check_figure(explorer.figure, explorer.numbers, 0.2,
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
+
+
+def test_a_compensate_with_nan_after_the_delay_is_named():
+    def compensate(estimates, A, delay_steps):
+        out = reference.compensate(estimates, A, delay_steps)
+        out[delay_steps] = np.nan                        # one row too many left empty
+        return out
+
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem == ("compensate returned NaN in row 10 with δ = 10: eq. (7) gives "
+                                "a prediction in every row j >= δ")
+
+
+def test_a_broken_filter_shows_one_line_from_the_start():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return reference.lqe_filter(y, A, C, Q, R, z0, P0)[:, 0]      # positions only
+
+    explorer = explore_delay(filter=my_filter)
+    assert explorer.problem.startswith("my_filter returned")
+    assert "shape (1000,)" in explorer.problem and "(1000, 3)" in explorer.problem
+    assert explorer.png.startswith(b"\x89PNG")           # the empty axes, no traceback
+
+    def raises(y, A, C, Q, R, z0, P0):
+        return np.linalg.inv(C)                          # C is 1 × 3: not invertible
+
+    problem = explore_delay(filter=raises).problem
+    assert problem.startswith("raises raised LinAlgError"), problem
+    assert "(in raises, line" in problem
+
+
+def test_functions_not_written_yet_say_so():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError
+
+    def compensate(estimates, A, delay_steps):
+        raise NotImplementedError
+
+    assert explore_delay(filter=my_filter).problem.startswith("my_filter is not written yet")
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem.startswith("compensate is not written yet")
+    assert "run the explorer's cell again" in explorer.problem
+
+
+@pytest.mark.parametrize("name", ["filter", "compensate"])
+def test_a_function_argument_that_is_not_a_function_is_refused(name):
+    with pytest.raises(ValueError, match=f"{name} must be None or a function.*got a ndarray"):
+        explore_delay(**{name: np.zeros(3)})
+    with pytest.raises(ValueError, match=f"{name} must be None or a function"):
+        draw_delay(fresh_figure(), delay=0.1, **{name: "my_filter"})
+
+
+def test_draw_function_runs_the_students_functions():
+    figure = fresh_figure()
+    numbers = draw_delay(figure, delay=0.17, filter=my_filter, compensate=compensate)
+    assert "(your my_filter and your compensate)" in numbers
+    _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
