@@ -7,13 +7,14 @@ import re
 
 import numpy as np
 import pytest
-import reference_loops as reference
 from explorer_checks import EXPLORER_SCENARIO, explorer_draw, fresh_figure, lines_by_gid
 from matplotlib.figure import Figure
 from matplotlib.text import Text
 
 from lqe_helpers import experiments
 from lqe_helpers.explorers.delay import MAX_DELAY, WINDOW, draw_delay, explore_delay
+from lqe_helpers.filter import kalman_filter
+from lqe_helpers.prediction import predict_ahead
 from lqe_helpers.scenario import DEFAULT
 
 SHOWN = DEFAULT.times <= WINDOW
@@ -239,14 +240,17 @@ def test_scenario_delay_beyond_the_slider_range_is_refused():
 # The student's own my_filter and compensate drive the sliders (issue 15 §4)
 # ------------------------------------------------------------------------------------------
 
+# This file ships in the student pack, so a "student's" function here calls the pack's
+# engine rather than spell out a worked answer of notebook 01 or 05 Task 1.
+
 def my_filter(y, A, C, Q, R, z0, P0):
-    """A student's correct filter (the tests' plain eq. (5) loop)."""
-    return reference.lqe_filter(y, A, C, Q, R, z0, P0)
+    """A student's correct filter of eq. (5)."""
+    return kalman_filter(y, A, C, Q, R, z0, P0).estimates
 
 
 def compensate(estimates, A, delay_steps):
     """A student's correct eq. (7)."""
-    return reference.compensate(estimates, A, delay_steps)
+    return predict_ahead(estimates, A, delay_steps)
 
 
 @pytest.mark.parametrize("delay", [0.1, 0.0, 0.37])
@@ -289,7 +293,7 @@ def test_a_broken_compensate_shows_one_line_and_the_next_move_draws_again():
     def compensate(estimates, A, delay_steps):
         if delay_steps > 20:
             return estimates[delay_steps:] @ np.linalg.matrix_power(A, delay_steps).T
-        return reference.compensate(estimates, A, delay_steps)
+        return predict_ahead(estimates, A, delay_steps)
 
     explorer = explore_delay(compensate=compensate)
     assert explorer.problem == ""
@@ -306,7 +310,7 @@ def test_a_broken_compensate_shows_one_line_and_the_next_move_draws_again():
 
 def test_a_compensate_with_nan_after_the_delay_is_named():
     def compensate(estimates, A, delay_steps):
-        out = reference.compensate(estimates, A, delay_steps)
+        out = predict_ahead(estimates, A, delay_steps)
         out[delay_steps] = np.nan                        # one row too many left empty
         return out
 
@@ -317,7 +321,7 @@ def test_a_compensate_with_nan_after_the_delay_is_named():
 
 def test_a_broken_filter_shows_one_line_from_the_start():
     def my_filter(y, A, C, Q, R, z0, P0):
-        return reference.lqe_filter(y, A, C, Q, R, z0, P0)[:, 0]      # positions only
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates[:, 0]      # positions only
 
     explorer = explore_delay(filter=my_filter)
     assert explorer.problem.startswith("my_filter returned")
@@ -358,3 +362,26 @@ def test_draw_function_runs_the_students_functions():
     numbers = draw_delay(figure, delay=0.17, filter=my_filter, compensate=compensate)
     assert "(your my_filter and your compensate)" in numbers
     _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_the_explorer_draws_the_students_numbers_not_the_engines():
+    """A filter 1 cm off and a compensation 2 cm off show up in the lines and the MSEs."""
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates + np.array([1.0, 0.0, 0.0])
+
+    def compensate(estimates, A, delay_steps):
+        return predict_ahead(estimates, A, delay_steps) + np.array([2.0, 0.0, 0.0])
+
+    theirs = explore_delay(filter=my_filter, compensate=compensate)
+    engine = _lines(explore_delay().figure)
+    mine = _lines(theirs.figure)
+    arrived = slice(DEFAULT.delay_steps(DEFAULT.delay), None)
+    np.testing.assert_allclose((mine["delayed"] - engine["delayed"])[arrived], 1.0, atol=1e-9)
+    np.testing.assert_allclose((mine["prediction"] - engine["prediction"])[arrived], 3.0,
+                               atol=1e-9)
+    np.testing.assert_array_equal(mine["vision"], engine["vision"])      # the same readings
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
+    expected = _independent(DEFAULT.delay, noise)
+    skip = max(DEFAULT.burn_in_steps, expected["steps"])
+    shifted = expected["lines"]["prediction"][skip:] + 3.0 - DEFAULT.truth[skip:, 0]
+    assert f"compensated {np.mean(shifted ** 2):.2f} cm²" in theirs.numbers
