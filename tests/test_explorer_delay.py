@@ -385,3 +385,17 @@ def test_the_explorer_draws_the_students_numbers_not_the_engines():
     skip = max(DEFAULT.burn_in_steps, expected["steps"])
     shifted = expected["lines"]["prediction"][skip:] + 3.0 - DEFAULT.truth[skip:, 0]
     assert f"compensated {np.mean(shifted ** 2):.2f} cm²" in theirs.numbers
+
+
+def test_functions_not_saved_yet_say_so_in_one_line(tmp_path, monkeypatch):
+    """The notebook's explorer cell loads the saved functions: before they exist, one line."""
+    from lqe_helpers import student_code
+
+    monkeypatch.chdir(tmp_path)                      # no my_functions/ here
+    filter_, compensate_ = student_code.load("my_filter"), student_code.load("compensate")
+    explorer = explore_delay(filter=filter_, compensate=compensate_)
+    assert explorer.problem.startswith("my_filter is not saved yet: my_functions/my_filter.py "
+                                       "does not exist")
+    explorer = explore_delay(compensate=compensate_)
+    assert explorer.problem.startswith("compensate is not saved yet")
+    assert "\n" not in explorer.problem
