@@ -106,6 +106,25 @@ def test_check_compensation_rejects_changing_the_estimates_in_place() -> None:
                  compensate)
 
 
+def test_check_compensation_refuses_the_packs_own_eq7() -> None:
+    """Issue 15 §2: calling the pack's answer is not writing eq. (7)."""
+    from lqe_helpers import prediction
+    from lqe_helpers.prediction import predict_ahead as ahead
+
+    def compensate(estimates, A, delay_steps):
+        return prediction.predict_ahead(estimates, A, delay_steps)
+
+    def renamed(estimates, A, delay_steps):
+        try:
+            return ahead(estimates, A, delay_steps)
+        except Exception:
+            return reference.compensate(estimates, A, delay_steps)
+
+    for function in (compensate, renamed, prediction.predict_ahead):
+        assert_fails("runs the pack's own lqe_helpers.prediction.predict_ahead",
+                     checks.check_compensation, function)
+
+
 def test_check_compensation_says_not_written_yet() -> None:
     def compensate(estimates, A, delay_steps):
         raise NotImplementedError

@@ -45,6 +45,10 @@ from .machinery import (
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
+#: The pack's own eq. (7), which a student's ``compensate`` may not run (directly, or
+#: through experiments.delay_and_compensate, which calls it).
+_PACKS_EQ7 = (predict_ahead,)
+
 _SHAPE_HINT = (
     "The shapes in one product or assignment do not fit: write the shape beside each "
     "term (the estimates are (n, k), one estimate ẑ_j is (k,), A^δ is (k, k)).")
@@ -74,7 +78,8 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
     CheckFailed
         With the mistake named: wrong shape, off-by-one delay or power, A·δ or an
         entry-wise power instead of A^δ, no shift, zeros or estimates instead of NaN
-        before δ, A unused, ...
+        before δ, A unused, ...; or if it runs the pack's own eq. (7)
+        (:func:`lqe_helpers.prediction.predict_ahead`) instead of computing it.
     """
     name = require_callable(compensate, "compensate", "check_compensation")
     cases = compensation_cases.cases()
@@ -127,7 +132,7 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
 def _run(compensate: Callable, name: str, case: Case) -> np.ndarray:
     output = call_student(compensate, case.estimates, case.A, case.delay, name=name,
                           where=case.describe(), arg_names=COMPENSATE_ARGS,
-                          shape_hint=_SHAPE_HINT)
+                          shape_hint=_SHAPE_HINT, forbid=_PACKS_EQ7)
     n, k = case.estimates.shape
     what = f"z*, the compensated estimates, shape (n, k) = {(n, k)}"
     array = student_result(output, name=name, what=what, allow_nan=True, where=case.describe())
@@ -173,7 +178,7 @@ def _check_head(name: str, answer: np.ndarray, case: Case) -> None:
 
 def _check_zero_delay(compensate: Callable, name: str, case: Case) -> None:
     output = call_student(compensate, case.estimates, case.A, 0, name=name,
-                          where=case.describe(), arg_names=COMPENSATE_ARGS,
+                          where=case.describe(), arg_names=COMPENSATE_ARGS, forbid=_PACKS_EQ7,
                           hint=_ZERO_DELAY_HINT)
     array = student_result(output, name=name, what="z*, the compensated estimates",
                            allow_nan=True, where=case.describe())
