@@ -35,6 +35,7 @@ from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
+from .fusion import with_student_estimates
 from .panels import DATA_UNDER_LINES, reuse_panels
 from .sliders import float_slider, starting_value
 
@@ -149,8 +150,7 @@ def _check_functions(filter: object, compensate: object) -> None:
                              f"{type(function).__name__}")
 
 
-#: Names of the parameters of a student's ``my_filter`` and ``compensate``, for messages.
-_FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+#: Names of the parameters of a student's ``compensate``, for messages.
 _COMPENSATE_ARGS = ("estimates", "A", "delay_steps")
 
 
@@ -158,22 +158,12 @@ def _filter_run(scenario: Scenario, noise: np.ndarray,
                 filter: Callable | None) -> experiments.Tracking:
     """The vision-only run on ``noise``: the engine's, or its readings filtered by ``filter``.
 
-    With a student's filter the result holds the student's estimates; its gains and
-    covariances (which the explorer does not draw) stay the engine's.
+    With a student's filter the result holds the student's estimates
+    (:func:`~lqe_helpers.explorers.fusion.with_student_estimates`, shared with the fusion
+    explorer); its gains and covariances (which this explorer does not draw) stay the
+    engine's.
     """
-    tracking = experiments.track(scenario, SENSORS, noise=noise)
-    if filter is None:
-        return tracking
-    name = student_code.function_name(filter)
-    m = tracking.model
-    output = student_code.call(filter, tracking.measurements, m.A, m.C, m.Q, m.R, m.z0, m.P0,
-                               name=name, where="the explorer's trial",
-                               arg_names=_FILTER_ARGS, rerun="run the explorer's cell again")
-    estimates = student_code.result_array(
-        output, name=name, shape=tracking.result.estimates.shape,
-        what=f"the estimates ẑ, shape {tracking.result.estimates.shape}")
-    return dataclasses.replace(tracking,
-                               result=dataclasses.replace(tracking.result, estimates=estimates))
+    return with_student_estimates(experiments.track(scenario, SENSORS, noise=noise), filter)
 
 
 def _compensated(delayed: experiments.DelayedTracking,
