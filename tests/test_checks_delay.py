@@ -106,6 +106,25 @@ def test_check_compensation_rejects_changing_the_estimates_in_place() -> None:
                  compensate)
 
 
+def test_check_compensation_refuses_the_packs_own_eq7() -> None:
+    """Issue 15 §2: calling the pack's answer is not writing eq. (7)."""
+    from lqe_helpers import prediction
+    from lqe_helpers.prediction import predict_ahead as ahead
+
+    def compensate(estimates, A, delay_steps):
+        return prediction.predict_ahead(estimates, A, delay_steps)
+
+    def renamed(estimates, A, delay_steps):
+        try:
+            return ahead(estimates, A, delay_steps)
+        except Exception:
+            return reference.compensate(estimates, A, delay_steps)
+
+    for function in (compensate, renamed, prediction.predict_ahead):
+        assert_fails("runs the pack's own lqe_helpers.prediction.predict_ahead",
+                     checks.check_compensation, function)
+
+
 def test_check_compensation_says_not_written_yet() -> None:
     def compensate(estimates, A, delay_steps):
         raise NotImplementedError
@@ -151,41 +170,77 @@ def test_check_compensation_refuses_inf_and_huge_values() -> None:
 
 TRUTH = DEFAULT.truth[:, 0]
 BURN = DEFAULT.burn_in_steps
+STEPS = DEFAULT.delay_steps(DEFAULT.delay)
+#: Task 2's given inputs: the trial's readings (n, 1) and the model of the vision-only filter.
+READINGS = simulation.measure(TRUTH, DEFAULT.unit_noise(sensors=("vision",)), [DEFAULT.sigma_v])
+VISION = experiments.filter_model(DEFAULT)
 
 
-def task2(slip: str = "") -> tuple[float, float]:
-    """Task 2 as a student writes it (the notebook's worked code), with one ``slip``."""
-    steps = DEFAULT.delay_steps(DEFAULT.delay) + (slip == "one sample late")
-    tracking = experiments.track(DEFAULT)
-    estimates = tracking.result.estimates
-    late_readings = simulation.delay_signal(tracking.measurements, steps)[:, 0]
-    delayed_estimates = simulation.delay_signal(estimates, steps)
-    delayed = late_readings if slip == "late readings" else delayed_estimates[:, 0]
-    source = delayed_estimates if slip == "compensate the delayed" else estimates
+def task2(slip: str = "") -> tuple:
+    """Task 2 as a student writes it (the notebook's worked code), with one ``slip``.
+
+    Returns (late_readings, delayed, compensated, mse_delayed_run, mse_compensated_run).
+    """
+    y, m = READINGS, VISION
+    steps = STEPS + (slip == "one sample late")
+    estimates = reference.lqe_filter(y, m.A, m.C, m.Q, m.R, m.z0, m.P0)   # my_filter
+    late_readings = simulation.delay_signal(y, steps)[:, 0]
+    if slip == "np.roll":
+        late_readings = np.roll(y, steps, axis=0)[:, 0]
+    delayed_states = simulation.delay_signal(estimates, steps)
+    delayed = {"whole states": delayed_states, "not delayed": estimates[:, 0],
+               "late readings": late_readings}.get(slip, delayed_states[:, 0])
+    source = delayed_states if slip == "compensate the delayed" else estimates
     compensated = student_compensate(source, DEFAULT.A, steps)[:, 0]
     skip = {"whole trial": 0, "skip only delta": steps}.get(slip, max(BURN, steps))
-    mse_delayed_run = np.mean((delayed[skip:] - TRUTH[skip:]) ** 2)
-    mse_compensated_run = np.mean((compensated[skip:] - TRUTH[skip:]) ** 2)
+    if slip == "nanmean":
+        mse_delayed_run = np.nanmean((delayed - TRUTH) ** 2)
+        mse_compensated_run = np.nanmean((compensated - TRUTH) ** 2)
+    else:   # the whole states' slip keeps the position column here, not in the array
+        positions = delayed_states[:, 0] if slip == "whole states" else delayed
+        mse_delayed_run = np.mean((positions[skip:] - TRUTH[skip:]) ** 2)
+        mse_compensated_run = np.mean((compensated[skip:] - TRUTH[skip:]) ** 2)
+    if slip == "rmse":
+        mse_compensated_run = np.sqrt(mse_compensated_run)
     if slip == "swapped":
-        return mse_compensated_run, mse_delayed_run
-    return mse_delayed_run, mse_compensated_run
+        mse_delayed_run, mse_compensated_run = mse_compensated_run, mse_delayed_run
+    return late_readings, delayed, compensated, mse_delayed_run, mse_compensated_run
 
 
 def test_check_delay_mse_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_delay_mse, *task2())
-    assert "δ = 10 samples, after the first 100" in line
+    assert "(δ = 10 samples) match the pack's engine" in line
+    assert "their MSEs (after the first 100 samples) to 1e-6 relative" in line
+
+
+def test_task2_inputs_are_those_of_the_engine() -> None:
+    """The readings and model the notebook gives are the scenario's trial: the check's draw."""
+    tracking = experiments.track(DEFAULT)
+    np.testing.assert_array_equal(READINGS, tracking.measurements)
+    np.testing.assert_allclose(reference.lqe_filter(READINGS, *(
+        getattr(VISION, name) for name in ("A", "C", "Q", "R", "z0", "P0"))),
+        tracking.result.estimates, rtol=0, atol=1e-10)
 
 
 @pytest.mark.parametrize(("slip", "phrase"), [
-    ("compensate the delayed", "mse_compensated_run = 4.96517 cm² is not right"),
-    ("compensate the delayed", "the compensation was applied to the delayed estimates"),
+    ("compensate the delayed", "compensated is not right: compensate was given the delayed "
+                               "estimates, so it predicts from 2δ samples back"),
     ("whole trial", "mse_delayed_run is NaN (not a number): the first δ samples"),
     ("skip only delta", "it leaves out only the first δ = 10 samples; leave out the burn-in too"),
+    ("nanmean", "mse_delayed_run = 5.20409 cm² is not right"),
+    ("nanmean", "it leaves out only the first δ = 10 samples; leave out the burn-in too"),
     ("swapped", "mse_delayed_run = 1.9"),
     ("swapped", "it is the MSE of the compensated estimate, not of the delayed one"),
-    ("one sample late", "mse_delayed_run = 5.99762 cm² is not right"),
-    ("one sample late", "the delay is one sample too long (δ + 1)"),
-    ("late readings", "it is the MSE of the late readings, not of an estimate"),
+    ("one sample late", "late_readings is not right: the delay is one sample too long (δ + 1)"),
+    ("late readings", "delayed is not right: it holds the late readings, not the delayed "
+                      "estimate"),
+    ("np.roll", "late_readings is not right: it was shifted with np.roll, which wraps"),
+    ("whole states", "delayed has shape (1000, 3), whole states (p, v, a) per row: keep only "
+                     "the positions, column 0"),
+    ("not delayed", "delayed is not right: it is not delayed: these are the estimates as the "
+                    "filter made them"),
+    ("rmse", "mse_compensated_run = 1.38"),
+    ("rmse", "it is the root mean squared error (RMSE, in cm)"),
 ])
 def test_check_delay_mse_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_delay_mse, *task2(slip))
@@ -193,20 +248,46 @@ def test_check_delay_mse_names_the_cause_of_wrong_science(slip: str, phrase: str
 
 def test_check_delay_mse_catches_the_compensation_that_reverses_the_answer() -> None:
     """Issue 15: compensating the wrong estimates makes compensation look useless."""
-    delayed, compensated = task2("compensate the delayed")
-    assert compensated > 0.95 * delayed > 2 * task2()[1]   # the benefit of (e) is gone
-    assert_fails("applied to the delayed estimates", checks.check_delay_mse, delayed,
-                 compensated)
+    *_, delayed, compensated = task2("compensate the delayed")
+    assert compensated > 0.95 * delayed > 2 * task2()[4]   # the benefit of (e) is gone
+    assert_fails("given the delayed estimates", checks.check_delay_mse,
+                 *task2("compensate the delayed"))
+
+
+def test_check_delay_mse_names_nan_in_the_wrong_places() -> None:
+    late, delayed, compensated, *mses = task2()
+    shifted = compensated.copy()
+    shifted[STEPS] = np.nan
+    assert_fails("compensated must be NaN in exactly its first δ = 10 samples (nothing has "
+                 "arrived before j = δ) and a number after; yours has NaN in 11 samples",
+                 checks.check_delay_mse, late, delayed, shifted, *mses)
+
+
+def test_check_delay_mse_refuses_another_draw() -> None:
+    """Numbers from another noise draw agree with each other but not with the task's."""
+    other = scenario.Scenario(seed=DEFAULT.seed + 1)
+    tracking = experiments.track(other)
+    late = simulation.delay_signal(tracking.measurements, STEPS)[:, 0]
+    _, delayed, compensated, *mses = task2()
+    assert_fails("late_readings does not match the signal recomputed from the task's inputs",
+                 checks.check_delay_mse, late, delayed, compensated, *mses)
 
 
 def test_check_delay_mse_wants_numbers() -> None:
-    delayed, compensated = task2()
+    late, delayed, compensated, mse_delayed, mse_compensated = task2()
+    signals = (late, delayed, compensated)
     assert_fails("mse_delayed_run must be one number (cm²), got None", checks.check_delay_mse,
-                 None, compensated)
+                 *signals, None, mse_compensated)
     assert_fails("mse_compensated_run must be one number (cm²), got text ('1.92')",
-                 checks.check_delay_mse, delayed, "1.92")
+                 checks.check_delay_mse, *signals, mse_delayed, "1.92")
     assert_fails("mse_compensated_run must be one number (cm²), got values too large to square",
-                 checks.check_delay_mse, delayed, 1e300)
+                 checks.check_delay_mse, *signals, mse_delayed, 1e300)
+    assert_fails("late_readings must be positions (cm), an array of shape (1000,), got None",
+                 checks.check_delay_mse, None, delayed, compensated, mse_delayed,
+                 mse_compensated)
+    assert_fails("delayed must be positions (cm) of shape (1000,), one per sample, got shape "
+                 "(990,)", checks.check_delay_mse, late, delayed[STEPS:], compensated,
+                 mse_delayed, mse_compensated)
 
 
 # ------------------------------------------------------------------------------------------
@@ -214,29 +295,46 @@ def test_check_delay_mse_wants_numbers() -> None:
 # ------------------------------------------------------------------------------------------
 
 
-def task3(slip: str = ""):
-    """Task 3 as a student writes it (the notebook's worked code), with one ``slip``."""
+def task3(slip: str = "") -> tuple:
+    """Task 3 as a student writes it (the notebook's worked code), with one ``slip``.
+
+    Returns (gain, won_back).
+    """
     tracking_mc = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
     batch = experiments.delay_and_compensate(tracking_mc, DEFAULT.delay)
     mse_delayed, mse_predicted = batch.mse("delayed"), batch.mse("predicted")
     mse_now = tracking_mc.mse()
+    gain = metrics.mean_ci95(mse_delayed - mse_predicted)
+    won_back = metrics.mean_ci95((mse_delayed - mse_predicted) / (mse_delayed - mse_now))
     if slip == "reversed":
-        return metrics.mean_ci95(mse_predicted - mse_delayed)
-    if slip == "against no delay":
-        return metrics.mean_ci95(mse_delayed - mse_now)
-    if slip == "separate intervals":
+        gain = metrics.mean_ci95(mse_predicted - mse_delayed)
+    elif slip == "against no delay":
+        gain = metrics.mean_ci95(mse_delayed - mse_now)
+    elif slip == "separate intervals":
         a, b = metrics.mean_ci95(mse_delayed), metrics.mean_ci95(mse_predicted)
-        return metrics.Interval(a.mean - b.mean, a.low - b.high, a.high - b.low, a.runs)
-    if slip == "difference of means":
-        return mse_delayed.mean() - mse_predicted.mean()
-    if slip == "fewer runs":
-        return metrics.mean_ci95((mse_delayed - mse_predicted)[:100])
-    return metrics.mean_ci95(mse_delayed - mse_predicted)
+        gain = metrics.Interval(a.mean - b.mean, a.low - b.high, a.high - b.low, a.runs)
+    elif slip == "difference of means":
+        gain = mse_delayed.mean() - mse_predicted.mean()
+    elif slip == "fewer runs":
+        gain = metrics.mean_ci95((mse_delayed - mse_predicted)[:100])
+    elif slip == "share of the delayed MSE":
+        won_back = metrics.mean_ci95(1 - mse_predicted / mse_delayed)
+    elif slip == "share left":
+        won_back = metrics.mean_ci95((mse_predicted - mse_now) / (mse_delayed - mse_now))
+    elif slip == "per cent":
+        won_back = metrics.mean_ci95(100 * (mse_delayed - mse_predicted)
+                                     / (mse_delayed - mse_now))
+    elif slip == "ratio of means":
+        won_back = ((mse_delayed.mean() - mse_predicted.mean())
+                    / (mse_delayed.mean() - mse_now.mean()))
+    elif slip == "upside down":
+        won_back = metrics.mean_ci95((mse_delayed - mse_now) / (mse_delayed - mse_predicted))
+    return gain, won_back
 
 
 def test_check_delay_difference_passes_the_worked_answer(capsys) -> None:
-    line = assert_passes(capsys, checks.check_delay_difference, task3())
-    assert "delayed − compensated MSE, paired over 300 runs" in line
+    line = assert_passes(capsys, checks.check_delay_difference, *task3())
+    assert "delayed − compensated MSE, paired over 300 runs, and the share" in line
 
 
 @pytest.mark.parametrize(("slip", "phrase"), [
@@ -245,18 +343,26 @@ def test_check_delay_difference_passes_the_worked_answer(capsys) -> None:
     ("separate intervals", "it combines the two separate intervals"),
     ("difference of means", "gain is a number; it must be the metrics.Interval"),
     ("fewer runs", "gain is over 100 runs, but the task has 300"),
+    ("share of the delayed MSE", "won_back is not right: it is the share of the delayed MSE"),
+    ("share left", "won_back is not right: it is the share of the delay's cost that is left"),
+    ("per cent", "won_back is not right: it is in per cent"),
+    ("ratio of means", "won_back is a number; it must be the metrics.Interval"),
+    ("upside down", "won_back is not right: the ratio is upside down"),
 ])
 def test_check_delay_difference_names_the_cause(slip: str, phrase: str) -> None:
-    assert_fails(phrase, checks.check_delay_difference, task3(slip))
+    assert_fails(phrase, checks.check_delay_difference, *task3(slip))
 
 
 def test_check_delay_difference_judges_against_the_engine() -> None:
     other = scenario.Scenario(seed=DEFAULT.seed + 1)
-    batch = experiments.delay_and_compensate(experiments.track(other, runs=DEFAULT.mc_runs),
-                                             DEFAULT.delay)
-    gain = metrics.mean_ci95(batch.mse("delayed") - batch.mse("predicted"))
+    tracking = experiments.track(other, runs=DEFAULT.mc_runs)
+    batch = experiments.delay_and_compensate(tracking, DEFAULT.delay)
+    delayed, predicted = batch.mse("delayed"), batch.mse("predicted")
+    gain = metrics.mean_ci95(delayed - predicted)
+    won_back = metrics.mean_ci95((delayed - predicted) / (delayed - tracking.mse()))
     assert_fails("does not match the paired difference delayed − compensated MSE",
-                 checks.check_delay_difference, gain)
+                 checks.check_delay_difference, gain, task3()[1])
+    assert_fails("won_back (mean 0.5", checks.check_delay_difference, task3()[0], won_back)
 
 
 def test_check_compensation_says_float32_keeps_too_few_digits() -> None:

@@ -13,6 +13,8 @@ from matplotlib.text import Text
 
 from lqe_helpers import experiments
 from lqe_helpers.explorers.delay import MAX_DELAY, WINDOW, draw_delay, explore_delay
+from lqe_helpers.filter import kalman_filter
+from lqe_helpers.prediction import predict_ahead
 from lqe_helpers.scenario import DEFAULT
 
 SHOWN = DEFAULT.times <= WINDOW
@@ -232,3 +234,168 @@ def test_scenario_delay_beyond_the_slider_range_is_refused():
     scenario = dataclasses.replace(DEFAULT, delay=0.6)
     with pytest.raises(ValueError, match=r"scenario\.delay .*\[0, 0\.5\] s, got 0\.6 s"):
         explore_delay(scenario)
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own my_filter and compensate drive the sliders (issue 15 §4)
+# ------------------------------------------------------------------------------------------
+
+# This file ships in the student pack, so a "student's" function here calls the pack's
+# engine rather than spell out a worked answer of notebook 01 or 05 Task 1.
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A student's correct filter of eq. (5)."""
+    return kalman_filter(y, A, C, Q, R, z0, P0).estimates
+
+
+def compensate(estimates, A, delay_steps):
+    """A student's correct eq. (7)."""
+    return predict_ahead(estimates, A, delay_steps)
+
+
+@pytest.mark.parametrize("delay", [0.1, 0.0, 0.37])
+def test_the_students_functions_draw_what_the_engine_draws(delay):
+    calls = {"filter": 0, "compensate": 0}
+
+    def counted_filter(y, A, C, Q, R, z0, P0):
+        calls["filter"] += 1
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    def counted_compensate(estimates, A, delay_steps):
+        calls["compensate"] += 1
+        return compensate(estimates, A, delay_steps)
+
+    theirs = explore_delay(filter=counted_filter, compensate=counted_compensate)
+    ours = explore_delay()
+    for explorer in (theirs, ours):
+        explorer.sliders["delay"].value = delay
+    assert theirs.problem == ""
+    mine, engine = _lines(theirs.figure), _lines(ours.figure)
+    assert set(mine) == set(engine)
+    for gid in engine:
+        np.testing.assert_allclose(mine[gid], engine[gid], rtol=0, atol=1e-9, err_msg=gid)
+    assert "(your counted_filter and your counted_compensate)" in theirs.numbers
+    assert "(the pack’s engine)" in ours.numbers
+    assert theirs.numbers.split(":", 1)[1] == ours.numbers.split(":", 1)[1]
+    # The filter ran once (a delay only shifts its output); the compensation at each draw.
+    assert calls == {"filter": 1, "compensate": 1 + (delay != DEFAULT.delay)}
+    _check_figure(theirs.figure, theirs.numbers, delay,
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
+
+
+def test_either_function_alone_is_named_with_the_pack_for_the_other():
+    assert "(your my_filter and the pack’s eq. (7))" in explore_delay(filter=my_filter).numbers
+    assert ("(the pack’s filter and your compensate)"
+            in explore_delay(compensate=compensate).numbers)
+
+
+def test_a_broken_compensate_shows_one_line_and_the_next_move_draws_again():
+    def compensate(estimates, A, delay_steps):
+        if delay_steps > 20:
+            return estimates[delay_steps:] @ np.linalg.matrix_power(A, delay_steps).T
+        return predict_ahead(estimates, A, delay_steps)
+
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem == ""
+    picture = explorer.png
+    explorer.sliders["delay"].value = 0.3
+    assert explorer.problem.startswith("compensate returned an array of shape (970, 3)")
+    assert explorer.numbers == explorer.problem and "\n" not in explorer.problem
+    assert explorer.png == picture                      # the last picture stays
+    explorer.sliders["delay"].value = 0.2
+    assert explorer.problem == ""
+    _check_figure(explorer.figure, explorer.numbers, 0.2,
+                  EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
+
+
+def test_a_compensate_with_nan_after_the_delay_is_named():
+    def compensate(estimates, A, delay_steps):
+        out = predict_ahead(estimates, A, delay_steps)
+        out[delay_steps] = np.nan                        # one row too many left empty
+        return out
+
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem == ("compensate returned NaN in row 10 with δ = 10: eq. (7) gives "
+                                "a prediction in every row j >= δ")
+
+
+def test_a_broken_filter_shows_one_line_from_the_start():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates[:, 0]      # positions only
+
+    explorer = explore_delay(filter=my_filter)
+    assert explorer.problem.startswith("my_filter returned")
+    assert "shape (1000,)" in explorer.problem and "(1000, 3)" in explorer.problem
+    assert explorer.png.startswith(b"\x89PNG")           # the empty axes, no traceback
+
+    def raises(y, A, C, Q, R, z0, P0):
+        return np.linalg.inv(C)                          # C is 1 × 3: not invertible
+
+    problem = explore_delay(filter=raises).problem
+    assert problem.startswith("raises raised LinAlgError"), problem
+    assert "(in raises, line" in problem
+
+
+def test_functions_not_written_yet_say_so():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError
+
+    def compensate(estimates, A, delay_steps):
+        raise NotImplementedError
+
+    assert explore_delay(filter=my_filter).problem.startswith("my_filter is not written yet")
+    explorer = explore_delay(compensate=compensate)
+    assert explorer.problem.startswith("compensate is not written yet")
+    assert "run the explorer's cell again" in explorer.problem
+
+
+@pytest.mark.parametrize("name", ["filter", "compensate"])
+def test_a_function_argument_that_is_not_a_function_is_refused(name):
+    with pytest.raises(ValueError, match=f"{name} must be None or a function.*got a ndarray"):
+        explore_delay(**{name: np.zeros(3)})
+    with pytest.raises(ValueError, match=f"{name} must be None or a function"):
+        draw_delay(fresh_figure(), delay=0.1, **{name: "my_filter"})
+
+
+def test_draw_function_runs_the_students_functions():
+    figure = fresh_figure()
+    numbers = draw_delay(figure, delay=0.17, filter=my_filter, compensate=compensate)
+    assert "(your my_filter and your compensate)" in numbers
+    _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+def test_the_explorer_draws_the_students_numbers_not_the_engines():
+    """A filter 1 cm off and a compensation 2 cm off show up in the lines and the MSEs."""
+    def my_filter(y, A, C, Q, R, z0, P0):
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates + np.array([1.0, 0.0, 0.0])
+
+    def compensate(estimates, A, delay_steps):
+        return predict_ahead(estimates, A, delay_steps) + np.array([2.0, 0.0, 0.0])
+
+    theirs = explore_delay(filter=my_filter, compensate=compensate)
+    engine = _lines(explore_delay().figure)
+    mine = _lines(theirs.figure)
+    arrived = slice(DEFAULT.delay_steps(DEFAULT.delay), None)
+    np.testing.assert_allclose((mine["delayed"] - engine["delayed"])[arrived], 1.0, atol=1e-9)
+    np.testing.assert_allclose((mine["prediction"] - engine["prediction"])[arrived], 3.0,
+                               atol=1e-9)
+    np.testing.assert_array_equal(mine["vision"], engine["vision"])      # the same readings
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=("vision",))
+    expected = _independent(DEFAULT.delay, noise)
+    skip = max(DEFAULT.burn_in_steps, expected["steps"])
+    shifted = expected["lines"]["prediction"][skip:] + 3.0 - DEFAULT.truth[skip:, 0]
+    assert f"compensated {np.mean(shifted ** 2):.2f} cm²" in theirs.numbers
+
+
+def test_functions_not_saved_yet_say_so_in_one_line(tmp_path, monkeypatch):
+    """The notebook's explorer cell loads the saved functions: before they exist, one line."""
+    from lqe_helpers import student_code
+
+    monkeypatch.chdir(tmp_path)                      # no my_functions/ here
+    filter_, compensate_ = student_code.load("my_filter"), student_code.load("compensate")
+    explorer = explore_delay(filter=filter_, compensate=compensate_)
+    assert explorer.problem.startswith("my_filter is not saved yet: my_functions/my_filter.py "
+                                       "does not exist")
+    explorer = explore_delay(compensate=compensate_)
+    assert explorer.problem.startswith("compensate is not saved yet")
+    assert "\n" not in explorer.problem

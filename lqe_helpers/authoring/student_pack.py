@@ -70,7 +70,8 @@ INSTRUCTOR_TESTS = ("browser", "test_notebook_files.py", "test_student_edition.p
                     "reference_loops.py", "test_reference.py", "test_checks_background.py",
                     "test_checks_vision.py", "test_checks_initial_covariance.py",
                     "test_checks_fusion.py", "test_checks_numbers.py", "test_checks_delay.py",
-                    "test_checks_bias.py", "test_checks_noisier_proprioception.py")
+                    "test_checks_bias.py", "test_checks_noisier_proprioception.py",
+                    "test_checks_delay_going_further.py")
 #: A test that mentions these needs what the pack leaves out (authoring, worked notebooks).
 INSTRUCTOR_ONLY = re.compile(r"lqe_helpers\.authoring|from lqe_helpers import authoring"
                              r"|[\"']notebooks[\"']")

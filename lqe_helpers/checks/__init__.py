@@ -19,7 +19,8 @@ every ``check_…`` and the tolerances:
 - ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
   ``vision_further`` for its Going further), ``initial_covariance`` (02), ``fusion``
   (03, with ``fusion_further``), ``noisier_proprioception`` (04, with
-  ``misjudged_noise``), ``delay`` (05), ``bias`` (06);
+  ``misjudged_noise``), ``delay`` (05, with ``compensation_cases``; its Going further in
+  ``delay_sweep`` and ``delay_further``), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -30,6 +31,13 @@ every ``check_…`` and the tolerances:
 from .background import check_covariance_step, check_transition_matrix
 from .bias import check_bias_model
 from .delay import check_compensation, check_delay_difference, check_delay_mse
+from .delay_further import check_late_eye, check_short_delays
+from .delay_sweep import (
+    check_compensation_regimes,
+    check_delay_sweep,
+    check_error_sources,
+    check_prediction_theory,
+)
 from .fusion import check_fusion, check_fusion_difference, check_fusion_trial
 from .fusion_further import (
     THEORY_RTOL,
@@ -80,11 +88,14 @@ __all__ = [
     "check_assumed_sweep",
     "check_bias_model",
     "check_compensation",
+    "check_compensation_regimes",
     "check_convergence_time",
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
+    "check_delay_sweep",
     "check_equivalent_sensor",
+    "check_error_sources",
     "check_filter",
     "check_fusion",
     "check_fusion_difference",
@@ -92,6 +103,7 @@ __all__ = [
     "check_gain_shares",
     "check_halving",
     "check_initial_covariance",
+    "check_late_eye",
     "check_misjudged",
     "check_misjudged_nis",
     "check_mse",
@@ -101,10 +113,12 @@ __all__ = [
     "check_noisier_theory",
     "check_noisier_trial",
     "check_paired_difference",
+    "check_prediction_theory",
     "check_proprioception_sweep",
     "check_sampling_ratio",
     "check_settled_filter",
     "check_settled_variances",
+    "check_short_delays",
     "check_smoother",
     "check_smoother_comparison",
     "check_steady_state",

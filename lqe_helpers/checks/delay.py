@@ -2,17 +2,20 @@
 
 - :func:`check_compensation` (Task 1): the student's ``compensate`` on random cases,
   against the pack's :func:`lqe_helpers.prediction.predict_ahead`;
-- :func:`check_delay_mse` (Task 2): the delayed and compensated MSEs of one run,
-  recomputed from the scenario's draw with the engine;
+- :func:`check_delay_mse` (Task 2): the late readings, the delayed and the compensated
+  position of one run and their MSEs, recomputed from the scenario's draw with the engine;
 - :func:`check_delay_difference` (Task 3): the paired delayed − compensated difference
-  over the Monte Carlo runs, recomputed with :mod:`lqe_helpers.experiments`.
+  over the Monte Carlo runs and the share of the delay's cost won back, recomputed with
+  :mod:`lqe_helpers.experiments`.
+
+The Going further tasks are checked in :mod:`lqe_helpers.checks.delay_further`, which
+reuses the Monte Carlo runs kept here (:func:`monte_carlo_tracking`).
 """
 
 from __future__ import annotations
 
 import functools
 from collections.abc import Callable
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -20,13 +23,16 @@ from .. import experiments, metrics
 from ..prediction import predict_ahead
 from ..scenario import DEFAULT
 from ..simulation import delay_signal
+from . import compensation_cases
+from .compensation_cases import COMPENSATE_ARGS, COMPENSATION_MISTAKES, Case, mistaken
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
+    MISTAKE_RTOL,
     MSE_RTOL,
-    SEED,
     CheckFailed,
+    argument_array,
     call_student,
     close,
     match_mistake,
@@ -39,100 +45,9 @@ from .machinery import (
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
-#: (states k, samples n, delay δ) of the compensation check; n >= 2δ + 3 so that every
-#: shifted mistake has rows to compare.
-_COMPENSATION_CASES = ((3, 12, 3), (2, 10, 1), (1, 8, 2), (4, 12, 4), (3, 11, 2))
-_COMPENSATE_ARGS = ("estimates", "A", "delay_steps")
-
-
-@dataclass(frozen=True)
-class _Case:
-    estimates: np.ndarray
-    A: np.ndarray
-    delay: int
-
-    def describe(self) -> str:
-        n, k = self.estimates.shape
-        return (f"estimates of shape {(n, k)} (k = {k} state{'s' * (k != 1)}), A of shape "
-                f"{self.A.shape} and delay_steps = {self.delay}")
-
-
-@functools.cache
-def _cases() -> tuple[_Case, ...]:
-    rng = np.random.default_rng(SEED + 1)
-    cases = []
-    for k, n, delay in _COMPENSATION_CASES:
-        A = np.eye(k) + 0.4 * rng.normal(size=(k, k))
-        estimates = 3.0 * rng.normal(size=(n, k))
-        for array in (A, estimates):
-            array.setflags(write=False)
-        cases.append(_Case(estimates, A, delay))
-    return tuple(cases)
-
-
-def _mistaken(mistake: str, case: _Case) -> np.ndarray | None:
-    """Eq. (7) with one typical mistake; None if it cannot run on this case."""
-    estimates, A, d = case.estimates, case.A, case.delay
-    n = estimates.shape[0]
-
-    def moved(shift: int, matrix: np.ndarray | None) -> np.ndarray | None:
-        if matrix is None or not 0 <= shift < n:
-            return None
-        return delay_signal(estimates, shift) @ matrix.T
-
-    def power(p: int) -> np.ndarray | None:
-        return np.linalg.matrix_power(A, p) if p >= 0 else None
-
-    if mistake == "backwards":
-        out = np.full(estimates.shape, np.nan)
-        out[: n - d] = estimates[d:] @ power(d).T
-        return out
-    return {
-        "power_minus_one": lambda: moved(d, power(d - 1)),
-        "power_plus_one": lambda: moved(d, power(d + 1)),
-        "shift_minus_one": lambda: moved(d - 1, power(d)),
-        "shift_plus_one": lambda: moved(d + 1, power(d)),
-        "times_delta": lambda: moved(d, d * A),
-        "elementwise": lambda: moved(d, A**d),
-        "no_shift": lambda: estimates @ power(d).T,
-        "no_A": lambda: delay_signal(estimates, d),
-        "wrong_side": lambda: moved(d, power(d).T),
-    }[mistake]()
-
-
-_COMPENSATION_MISTAKES = {
-    "power_minus_one": (
-        "one power of A too few: your z*_j is A applied δ − 1 times to ẑ_(j−δ). Eq. (7) "
-        "applies A δ times, once per sample of delay"),
-    "power_plus_one": (
-        "one power of A too many: your z*_j is A applied δ + 1 times to ẑ_(j−δ). Eq. (7) "
-        "applies A δ times, once per sample of delay"),
-    "shift_minus_one": (
-        "off by one in the delay: your row j uses the estimate ẑ_(j−δ+1). Eq. (7) "
-        "predicts from the estimate δ samples back, ẑ_(j−δ)"),
-    "shift_plus_one": (
-        "off by one in the delay: your row j uses the estimate ẑ_(j−δ−1). Eq. (7) "
-        "predicts from the estimate δ samples back, ẑ_(j−δ)"),
-    "times_delta": (
-        "A is multiplied by the number δ (A·δ). Eq. (7) needs the matrix power A^δ: A "
-        "applied δ times in a row, one matrix product per sample"),
-    "elementwise": (
-        "A^δ is computed entry by entry (each entry of A raised to the power δ). The "
-        "matrix power is A multiplied by itself δ times with matrix products"),
-    "no_shift": (
-        "there is no shift: your row j is A^δ ẑ_j. Eq. (7) predicts from the estimate of "
-        "δ samples earlier, ẑ_(j−δ), the newest one the delayed senses allow"),
-    "backwards": (
-        "the shift goes the wrong way: your row j uses ẑ_(j+δ), an estimate from the "
-        "future. Eq. (7) uses ẑ_(j−δ), from δ samples earlier"),
-    "no_A": (
-        "A is not used: your row j is the delayed estimate ẑ_(j−δ) itself. Eq. (7) moves "
-        "it δ steps ahead with A^δ"),
-    "wrong_side": (
-        "A^δ is applied from the wrong side: your rows are (A^δ)ᵀ ẑ_(j−δ), i.e. each "
-        "estimate as a row times A^δ. Eq. (7) multiplies the column ẑ_(j−δ) by A^δ "
-        "from the left"),
-}
+#: The pack's own eq. (7), which a student's ``compensate`` may not run (directly, or
+#: through experiments.delay_and_compensate, which calls it).
+_PACKS_EQ7 = (predict_ahead,)
 
 _SHAPE_HINT = (
     "The shapes in one product or assignment do not fit: write the shape beside each "
@@ -163,13 +78,14 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
     CheckFailed
         With the mistake named: wrong shape, off-by-one delay or power, A·δ or an
         entry-wise power instead of A^δ, no shift, zeros or estimates instead of NaN
-        before δ, A unused, ...
+        before δ, A unused, ...; or if it runs the pack's own eq. (7)
+        (:func:`lqe_helpers.prediction.predict_ahead`) instead of computing it.
     """
     name = require_callable(compensate, "compensate", "check_compensation")
-    cases = _cases()
+    cases = compensation_cases.cases()
     correct = {i: predict_ahead(case.estimates, case.A, case.delay)
                for i, case in enumerate(cases)}
-    zero = _zero_delay_case()
+    zero = compensation_cases.zero_delay_case()
     answers = {i: _run(compensate, name, case) for i, case in enumerate(cases)}
 
     def core(index: int) -> slice:
@@ -184,12 +100,12 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
             defined[: core(index).start] = False
             return defined
 
-        mistake = match_mistake(list(_COMPENSATION_MISTAKES),
-                                lambda mistake, index: _mistaken(mistake, cases[index]),
+        mistake = match_mistake(list(COMPENSATION_MISTAKES),
+                                lambda mistake, index: mistaken(mistake, cases[index]),
                                 answers, correct, rows=defined_core_rows)
         if mistake is not None:
             raise CheckFailed(
-                f"{name} does not follow eq. (7): {_COMPENSATION_MISTAKES[mistake]}.")
+                f"{name} does not follow eq. (7): {COMPENSATION_MISTAKES[mistake]}.")
         raise CheckFailed(
             f"{name} does not give z*_j = A^δ ẑ_(j−δ) for j > δ on "
             f"{cases[wrong_core[0]].describe()}: rows from j = δ + 1 on differ from eq. (7), "
@@ -213,10 +129,10 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
            f"{tolerance_text(FUNCTION_RTOL)}, {time_limit_text()}")
 
 
-def _run(compensate: Callable, name: str, case: _Case) -> np.ndarray:
+def _run(compensate: Callable, name: str, case: Case) -> np.ndarray:
     output = call_student(compensate, case.estimates, case.A, case.delay, name=name,
-                          where=case.describe(), arg_names=_COMPENSATE_ARGS,
-                          shape_hint=_SHAPE_HINT)
+                          where=case.describe(), arg_names=COMPENSATE_ARGS,
+                          shape_hint=_SHAPE_HINT, forbid=_PACKS_EQ7)
     n, k = case.estimates.shape
     what = f"z*, the compensated estimates, shape (n, k) = {(n, k)}"
     array = student_result(output, name=name, what=what, allow_nan=True, where=case.describe())
@@ -240,7 +156,7 @@ def _run(compensate: Callable, name: str, case: _Case) -> np.ndarray:
     raise CheckFailed(f"{name} {message}")
 
 
-def _check_head(name: str, answer: np.ndarray, case: _Case) -> None:
+def _check_head(name: str, answer: np.ndarray, case: Case) -> None:
     """Rows j < δ must all be NaN."""
     delay = case.delay
     head = answer[:delay]
@@ -260,14 +176,9 @@ def _check_head(name: str, answer: np.ndarray, case: _Case) -> None:
         f"MSE cannot mistake them for predictions")
 
 
-def _zero_delay_case() -> _Case:
-    rng = np.random.default_rng(SEED + 2)
-    return _Case(rng.normal(size=(6, 3)), np.eye(3) + 0.4 * rng.normal(size=(3, 3)), 0)
-
-
-def _check_zero_delay(compensate: Callable, name: str, case: _Case) -> None:
+def _check_zero_delay(compensate: Callable, name: str, case: Case) -> None:
     output = call_student(compensate, case.estimates, case.A, 0, name=name,
-                          where=case.describe(), arg_names=_COMPENSATE_ARGS,
+                          where=case.describe(), arg_names=COMPENSATE_ARGS, forbid=_PACKS_EQ7,
                           hint=_ZERO_DELAY_HINT)
     array = student_result(output, name=name, what="z*, the compensated estimates",
                            allow_nan=True, where=case.describe())
@@ -286,93 +197,162 @@ def _check_zero_delay(compensate: Callable, name: str, case: _Case) -> None:
 
 _NAN_HINT = ("the first δ samples of a delayed or compensated estimate are NaN (nothing has "
              "arrived yet): leave out the first max(burn, δ) samples")
+_SIGNALS = ("late_readings", "delayed", "compensated")
 
 
 @functools.cache
 def _trial() -> dict[str, object]:
-    """The right MSEs (cm²) of Task 2 and the likely mistakes of each."""
+    """Task 2 recomputed: the three signals (n,) (cm), the two MSEs (cm²), their mistakes."""
     tracking = experiments.track(DEFAULT)
-    estimates = tracking.result.estimates
+    estimates, readings = tracking.result.estimates, tracking.measurements
     truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
     steps = DEFAULT.delay_steps(DEFAULT.delay)
     skip = max(burn, steps)
-    delayed = delay_signal(estimates, steps)[:, 0]
-    compensated = predict_ahead(estimates, DEFAULT.A, steps)[:, 0]
+
+    def late(x: np.ndarray, shift: int = steps) -> np.ndarray:
+        return delay_signal(x, shift)[:, 0]
+
+    def ahead(x: np.ndarray, shift: int = steps) -> np.ndarray:
+        return predict_ahead(x, DEFAULT.A, shift)[:, 0]
+
+    def rolled(x: np.ndarray) -> np.ndarray:
+        return np.roll(x, steps, axis=0)[:, 0]
+
+    signals = {"late_readings": late(readings), "delayed": late(estimates),
+               "compensated": ahead(estimates)}
+    off_by_one = {"the delay is one sample too long (δ + 1)": steps + 1,
+                  "the delay is one sample too short (δ − 1)": steps - 1}
+    wrapped = ("it was shifted with np.roll, which wraps the last δ samples round to the "
+               "start: nothing has arrived before j = δ, so those samples must be NaN "
+               "(simulation.delay_signal does this)")
+    signal_mistakes = {
+        "late_readings": {
+            "it is not delayed: these are the readings as they were taken, y_j. At time j "
+                "the observer has only y_(j−δ)": readings[:, 0],
+            wrapped: rolled(readings),
+            "it holds the delayed estimate, not the delayed readings": signals["delayed"],
+            **{cause: late(readings, shift) for cause, shift in off_by_one.items()},
+        },
+        "delayed": {
+            "it is not delayed: these are the estimates as the filter made them, ẑ_j. At "
+                "time j the newest estimate is ẑ_(j−δ)": estimates[:, 0],
+            wrapped: rolled(estimates),
+            "it holds the late readings, not the delayed estimate": signals["late_readings"],
+            "it holds the compensated estimate, not the delayed one": signals["compensated"],
+            **{cause: late(estimates, shift) for cause, shift in off_by_one.items()},
+        },
+        "compensated": {
+            "compensate was given the delayed estimates, so it predicts from 2δ samples "
+                "back: give it the estimates as the filter made them (row i is ẑ_i)":
+                (delay_signal(estimates, 2 * steps) @ np.linalg.matrix_power(
+                    DEFAULT.A, steps).T)[:, 0],
+            "it holds the delayed estimate, not the compensated one": signals["delayed"],
+            **{cause: ahead(estimates, shift) for cause, shift in off_by_one.items()},
+        },
+    }
 
     def mse(x: np.ndarray, start: int = skip) -> float | None:
         with np.errstate(invalid="ignore"):
             value = float(np.mean((x[start:] - truth[start:]) ** 2))
         return value if np.isfinite(value) else None
 
-    ahead = np.linalg.matrix_power(DEFAULT.A, steps)
     common = {
         "it is the MSE of the filter's estimate without any delay: shift the estimates δ "
         "samples later first": mse(estimates[:, 0]),
         "it is the MSE of the late readings, not of an estimate":
-            mse(delay_signal(tracking.measurements, steps)[:, 0]),
+            mse(signals["late_readings"]),
     }
-    compensated_mistakes = {
-        "the compensation was applied to the delayed estimates, so it predicts from 2δ "
-        "samples back: compensate the estimates as the filter gives them (row i is ẑ_i)":
-            mse((delay_signal(estimates, 2 * steps) @ ahead.T)[:, 0]),
-        "it is the MSE of the delayed estimate, not of the compensated one": mse(delayed),
-        "there is no shift: A^δ ẑ_j predicts the present estimate δ samples into the future":
-            mse((estimates @ ahead.T)[:, 0]),
-        "the delayed estimate was moved one step (A), not δ steps (A^δ)":
-            mse((delay_signal(estimates, steps) @ DEFAULT.A.T)[:, 0]),
-        "the delay is one sample too long (δ + 1)":
-            mse(predict_ahead(estimates, DEFAULT.A, steps + 1)[:, 0]),
-        "the delay is one sample too short (δ − 1)":
-            mse(predict_ahead(estimates, DEFAULT.A, steps - 1)[:, 0]),
-        **common, **mse_mistakes(compensated, truth, skip, dt),
+    mse_mistakes_by_kind = {
+        "compensated": {
+            "it is the MSE of the delayed estimate, not of the compensated one":
+                mse(signals["delayed"]),
+            **common, **mse_mistakes(signals["compensated"], truth, skip, dt)},
+        "delayed": {
+            "it is the MSE of the compensated estimate, not of the delayed one":
+                mse(signals["compensated"]),
+            **common, **mse_mistakes(signals["delayed"], truth, skip, dt)},
     }
-    delayed_mistakes = {
-        "it is the MSE of the compensated estimate, not of the delayed one": mse(compensated),
-        "the delay is one sample too long (δ + 1)":
-            mse(delay_signal(estimates, steps + 1)[:, 0]),
-        "the delay is one sample too short (δ − 1)":
-            mse(delay_signal(estimates, steps - 1)[:, 0]),
-        **common, **mse_mistakes(delayed, truth, skip, dt),
-    }
-    for mistakes, signal in ((compensated_mistakes, compensated), (delayed_mistakes, delayed)):
+    for kind, mistakes in mse_mistakes_by_kind.items():
         mistakes[f"it leaves out only the first δ = {steps} samples; leave out the burn-in "
-                 f"too, max(burn, δ) = {skip}"] = mse(signal, steps) if steps < skip else None
-    return {"delayed": mse(delayed), "compensated": mse(compensated),
-            "delayed_mistakes": delayed_mistakes, "compensated_mistakes": compensated_mistakes}
+                 f"too, max(burn, δ) = {skip}"] = (mse(signals[kind], steps) if steps < skip
+                                                    else None)
+    return {"signals": signals, "signal_mistakes": signal_mistakes, "steps": steps,
+            "mse": {kind: mse(signals[kind]) for kind in mse_mistakes_by_kind},
+            "mse_mistakes": mse_mistakes_by_kind}
 
 
-def check_delay_mse(mse_delayed_run: float, mse_compensated_run: float) -> None:
-    """Check Task 2's MSEs of the delayed and of the compensated position (one run).
+def _judge_signal(name: str, value: object, right: np.ndarray, steps: int,
+                  mistakes: dict[str, np.ndarray]) -> None:
+    """A position signal (n,) (cm) with NaN before δ, against ``right``; CheckFailed if wrong."""
+    n = right.shape[0]
+    got = argument_array(value, name, f"positions (cm), an array of shape ({n},)",
+                         allow_nan=True)
+    if got.shape in ((n, 1), (n, 3)):
+        what = "one column" if got.shape[1] == 1 else "whole states (p, v, a)"
+        raise CheckFailed(f"{name} has shape {got.shape}, {what} per row: keep only the "
+                          f"positions, column 0, as an array of shape ({n},)")
+    if got.shape != right.shape:
+        raise CheckFailed(f"{name} must be positions (cm) of shape ({n},), one per sample, "
+                          f"got shape {got.shape}")
+    if close(got, right, FUNCTION_RTOL):
+        return
+    for cause, wrong in mistakes.items():
+        if close(got, wrong, MISTAKE_RTOL) and not close(right, wrong, MISTAKE_RTOL):
+            raise CheckFailed(f"{name} is not right: {cause}")
+    nan = np.isnan(got)
+    if not np.array_equal(nan, np.isnan(right)):
+        raise CheckFailed(
+            f"{name} must be NaN in exactly its first δ = {steps} samples (nothing has "
+            f"arrived before j = δ) and a number after; yours has NaN in {int(nan.sum())} "
+            f"samples{f', the first at j = {int(np.argmax(nan))}' if nan.any() else ''}")
+    raise CheckFailed(
+        f"{name} does not match the signal recomputed from the task's inputs (to "
+        f"{tolerance_text(FUNCTION_RTOL)} of its largest value), and not by one of the usual "
+        f"mistakes: was it made from your my_filter's estimates of the trial's readings y?")
+
+
+def check_delay_mse(late_readings: np.ndarray, delayed: np.ndarray, compensated: np.ndarray,
+                    mse_delayed_run: float, mse_compensated_run: float) -> None:
+    """Check Task 2: the three signals of one delayed run and the MSEs of its two estimates.
 
     Recomputed from the task's own inputs before looking at the student's: the
-    vision-only run of the scenario's draw (:func:`lqe_helpers.experiments.track`), its
-    estimates delayed by δ = ``DEFAULT.delay`` / Δt samples
-    (:func:`lqe_helpers.simulation.delay_signal`) and compensated
-    (:func:`lqe_helpers.prediction.predict_ahead`); each MSE (cm²) after the first
-    max(burn-in, δ) samples must agree within :data:`MSE_RTOL` relative.
+    vision-only filter of eq. (5) on the scenario's draw (the pack's engine, which the
+    student's ``my_filter`` equals), its readings and estimates delayed by
+    δ = ``DEFAULT.delay`` / Δt samples (:func:`lqe_helpers.simulation.delay_signal`) and
+    compensated (:func:`lqe_helpers.prediction.predict_ahead`). Each signal's positions
+    (n,) must agree within :data:`FUNCTION_RTOL` of its largest value, NaN exactly in the
+    first δ samples; each MSE (cm², after the first max(burn-in, δ) samples) within
+    :data:`MSE_RTOL` relative.
 
     Parameters
     ----------
+    late_readings, delayed, compensated : array_like, shape (n,)
+        The student's y_(j−δ), ẑ_(j−δ) and z*_j positions (cm) on the wall-clock axis.
     mse_delayed_run, mse_compensated_run : float
         The student's MSEs (cm²).
 
     Raises
     ------
     CheckFailed
-        Naming the value and the likely cause: the delayed estimates compensated, the two
-        swapped, no shift, a delay a sample off, the undelayed estimate, the late
-        readings, NaN from the first δ samples, the RMSE, ...
+        Naming the value and the likely cause: a signal not delayed, wrapped round by
+        np.roll or a sample off, the delayed estimates compensated, two swapped, whole
+        states for positions; an MSE over NaN samples, of the wrong estimate, the RMSE, ...
     """
     right = _trial()
+    for name, value in zip(_SIGNALS, (late_readings, delayed, compensated), strict=True):
+        _judge_signal(name, value, right["signals"][name], right["steps"],
+                      right["signal_mistakes"][name])
     for name, value, kind in (("mse_delayed_run", mse_delayed_run, "delayed"),
                               ("mse_compensated_run", mse_compensated_run, "compensated")):
-        judge(name, value, right[kind], MSE_RTOL, unit="cm²", nan_hint=_NAN_HINT,
+        judge(name, value, right["mse"][kind], MSE_RTOL, unit="cm²", nan_hint=_NAN_HINT,
               what=f"the {kind} position's MSE recomputed from the task's inputs",
-              mistakes=right[f"{kind}_mistakes"])
-    steps = DEFAULT.delay_steps(DEFAULT.delay)
-    passed(f"the MSEs of the delayed and of the compensated position (δ = {steps} samples, "
-           f"after the first {max(DEFAULT.burn_in_steps, steps)}) match the pack's engine on "
-           f"the scenario's draw to {tolerance_text(MSE_RTOL)} relative")
+              mistakes=right["mse_mistakes"][kind])
+    steps = right["steps"]
+    passed(f"the late readings, the delayed and the compensated position (δ = {steps} "
+           f"samples) match the pack's engine on the scenario's draw to "
+           f"{tolerance_text(FUNCTION_RTOL)}, and their MSEs (after the first "
+           f"{max(DEFAULT.burn_in_steps, steps)} samples) to {tolerance_text(MSE_RTOL)} "
+           f"relative")
 
 
 # ------------------------------------------------------------------------------------------
@@ -380,9 +360,17 @@ def check_delay_mse(mse_delayed_run: float, mse_compensated_run: float) -> None:
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
-def _monte_carlo() -> dict[str, np.ndarray]:
-    """Per-run MSEs (runs,) (cm²): delayed, compensated and without delay (read-only)."""
+def monte_carlo_tracking() -> experiments.Tracking:
+    """Task 3's ``DEFAULT.mc_runs`` vision-only runs (the engine), kept for the later checks."""
     tracking = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    tracking.result.estimates.setflags(write=False)
+    return tracking
+
+
+@functools.cache
+def monte_carlo_mses() -> dict[str, np.ndarray]:
+    """Per-run MSEs (runs,) (cm²) at the question's delay: delayed, compensated, undelayed."""
+    tracking = monte_carlo_tracking()
     batch = experiments.delay_and_compensate(tracking, DEFAULT.delay)
     values = {"delayed": batch.mse("delayed"), "predicted": batch.mse("predicted"),
               "now": tracking.mse()}
@@ -391,27 +379,32 @@ def _monte_carlo() -> dict[str, np.ndarray]:
     return values
 
 
-def check_delay_difference(gain: metrics.Interval) -> None:
-    """Check Task 3's paired difference delayed − compensated MSE over the Monte Carlo runs.
+def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -> None:
+    """Check Task 3: delayed − compensated MSE, paired, and the share of the delay's cost won back.
 
     Recomputed from the task's inputs before looking at the student's: ``DEFAULT.mc_runs``
     vision-only runs (:func:`lqe_helpers.experiments.track`), delayed by ``DEFAULT.delay``
     and compensated (:func:`lqe_helpers.experiments.delay_and_compensate`), and
-    ``metrics.mean_ci95`` of the per-run differences; mean and ends must agree within
-    :data:`INTERVAL_RTOL` of the interval's scale.
+    ``metrics.mean_ci95`` of the per-run differences delayed − compensated and of the
+    per-run shares (delayed − compensated) / (delayed − undelayed); mean and ends must
+    agree within :data:`INTERVAL_RTOL` of the interval's scale.
 
     Parameters
     ----------
     gain : metrics.Interval
         The student's paired difference with its 95 % interval (cm²).
+    won_back : metrics.Interval
+        The student's share of the delay's cost that compensation wins back, a fraction.
 
     Raises
     ------
     CheckFailed
         With the likely cause: the sign reversed, an unpaired interval, the filter
-        without delay in place of one of the two, a ratio, one MSE alone, ...
+        without delay in place of one of the two, a ratio, one MSE alone; for the
+        share, the share of the delayed MSE, the share left, a ratio upside down, per
+        cent, ...
     """
-    runs = _monte_carlo()
+    runs = monte_carlo_mses()
     delayed, predicted, now = runs["delayed"], runs["predicted"], runs["now"]
     mistakes = {
         **interval_mistakes(delayed, predicted, "the delayed MSE", "the compensated MSE"),
@@ -428,6 +421,25 @@ def check_delay_difference(gain: metrics.Interval) -> None:
                    "recomputed from the task's inputs",
                    mistakes=mistakes, nan_hint="is the delay given in seconds (d = "
                    f"{DEFAULT.delay:g} s), not in samples?")
-    passed(f"delayed − compensated MSE, paired over {DEFAULT.mc_runs} runs: mean and 95 % "
-           f"interval match the pack's engine on the scenario's draws to "
-           f"{tolerance_text(INTERVAL_RTOL)} relative")
+    cost, won = delayed - now, delayed - predicted
+    right = metrics.mean_ci95(won / cost)
+    share_mistakes = {
+        "it is the share of the delayed MSE that compensation removes, (delayed − "
+        "compensated) / delayed; the delay's cost is what it adds to the filter without "
+        "delay, so divide by delayed − undelayed": metrics.mean_ci95(won / delayed),
+        "it is the share of the delay's cost that is left, (compensated − undelayed) / "
+        "(delayed − undelayed); the task asks for the share won back":
+            metrics.mean_ci95((predicted - now) / cost),
+        "the ratio is upside down: divide what compensation wins (delayed − compensated) by "
+        "what the delay costs (delayed − undelayed)": metrics.mean_ci95(cost / won),
+        "it is in per cent; give the share as a fraction (0.5 for half)":
+            metrics.Interval(100 * right.mean, 100 * right.low, 100 * right.high, right.runs),
+        "it divides by compensated − undelayed; the delay's cost is delayed − undelayed":
+            metrics.mean_ci95(won / (predicted - now)),
+    }
+    judge_interval("won_back", won_back, right, INTERVAL_RTOL,
+                   what="the share (delayed − compensated) / (delayed − undelayed) per run, "
+                   "recomputed from the task's inputs", mistakes=share_mistakes)
+    passed(f"delayed − compensated MSE, paired over {DEFAULT.mc_runs} runs, and the share "
+           f"of the delay's cost won back: means and 95 % intervals match the pack's engine "
+           f"on the scenario's draws to {tolerance_text(INTERVAL_RTOL)} relative")

@@ -7,10 +7,18 @@ filter's newest (delayed) estimate ``ẑ_{j−δ}`` and the compensated predicti
 errors of both estimates in a panel below. The numbers of the view (d, δ and this
 run's MSEs) are not drawn in the figure: the drawing function returns them as one
 line of text, which the explorer shows between the slider and the picture.
+
+The filter and the compensation may be the student's own (``my_filter`` of notebook
+01, ``compensate`` of notebook 05's Task 1): they are then called through
+:func:`lqe_helpers.student_code.call` (copies of the inputs, a time limit), the numbers
+line says whose code ran, and a function that fails raises
+:class:`~lqe_helpers.student_code.StudentCodeError`, which the explorer shows as one
+line.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from functools import partial
@@ -22,11 +30,12 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
-from .. import experiments
+from .. import experiments, student_code
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
+from .fusion import with_student_estimates
 from .panels import DATA_UNDER_LINES, reuse_panels
 from .sliders import float_slider, starting_value
 
@@ -65,7 +74,8 @@ class _Panels(NamedTuple):
 
 
 def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
-               noise: np.ndarray | None = None) -> str:
+               noise: np.ndarray | None = None, filter: Callable | None = None,
+               compensate: Callable | None = None) -> str:
     """Draw one run of the delayed, compensated vision-only filter on ``figure``.
 
     The top axes show the true position, the delayed visual readings, the delayed
@@ -74,9 +84,9 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
     show both estimates' errors (estimate − truth). Returns the delay and this run's
     MSEs (cm², over the whole trial after the burn-in or the delay, whichever is
     longer) with and without compensation, and of the same filter with no delay, as
-    one line of text (the explorer shows it beside the figure), e.g. "Delay
-    d = 0.10 s (δ = 10 steps). MSE of this run: delayed 4.99 cm², compensated
-    1.92 cm², no delay 0.30 cm²."
+    one line of text that says whose code ran (the explorer shows it beside the
+    figure), e.g. "Delay d = 0.10 s (δ = 10 steps). MSE of this run (the pack’s
+    engine): delayed 4.99 cm², compensated 1.92 cm², no delay 0.30 cm²."
 
     A figure already drawn by this function for the same scenario keeps its axes and
     only has its data replaced (redrawing axes from scratch costs more than the
@@ -92,27 +102,97 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
         Constants of the simulation (σ_v, Δt, the butterfly).
     noise : array_like, shape (n, 1), optional
         Unit noise of vision; default the scenario's fixed draw.
+    filter : callable, optional
+        A student's ``my_filter(y, A, C, Q, R, z0, P0)`` returning the estimates (n, 3)
+        (notebook 01), run in place of the pack's engine; default the engine.
+    compensate : callable, optional
+        A student's ``compensate(estimates, A, delay_steps)`` returning z* (n, 3)
+        (notebook 05, Task 1), run in place of the pack's eq. (7); default the pack's.
 
     Returns
     -------
     str
-        d (s), δ (steps) and the three MSEs (cm²).
+        d (s), δ (steps), whose code ran and the three MSEs (cm²).
 
     Raises
     ------
     ValueError
-        If ``delay`` is negative, not a multiple of Δt, or not shorter than the trial.
+        If ``delay`` is negative, not a multiple of Δt, or not shorter than the trial,
+        or ``filter`` or ``compensate`` is neither None nor a function.
+    StudentCodeError
+        If the student's function fails, does not return in time, or returns something
+        that is not the array asked for.
     """
     scenario.delay_steps(delay)  # validate before any work
+    _check_functions(filter, compensate)
     if noise is None:
         noise = scenario.unit_noise(sensors=SENSORS)
-    return _draw_tracking(figure, delay, experiments.track(scenario, SENSORS, noise=noise))
+    return _draw_tracking(figure, delay, _filter_run(scenario, noise, filter), compensate,
+                          _whose(filter, compensate))
 
 
-def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking) -> str:
+def _whose(filter: Callable | None, compensate: Callable | None) -> str:
+    """Whose code the numbers line reports: "your my_filter and your compensate", …"""
+    if filter is None and compensate is None:
+        return "the pack’s engine"
+    parts = ("the pack’s filter" if filter is None
+             else f"your {student_code.function_name(filter)}",
+             "the pack’s eq. (7)" if compensate is None
+             else f"your {student_code.function_name(compensate)}")
+    return " and ".join(parts)
+
+
+def _check_functions(filter: object, compensate: object) -> None:
+    for name, function in (("filter", filter), ("compensate", compensate)):
+        if function is not None and not callable(function):
+            raise ValueError(f"{name} must be None or a function (e.g. your my_filter / "
+                             f"compensate, without parentheses), got a "
+                             f"{type(function).__name__}")
+
+
+#: Names of the parameters of a student's ``compensate``, for messages.
+_COMPENSATE_ARGS = ("estimates", "A", "delay_steps")
+
+
+def _filter_run(scenario: Scenario, noise: np.ndarray,
+                filter: Callable | None) -> experiments.Tracking:
+    """The vision-only run on ``noise``: the engine's, or its readings filtered by ``filter``.
+
+    With a student's filter the result holds the student's estimates
+    (:func:`~lqe_helpers.explorers.fusion.with_student_estimates`, shared with the fusion
+    explorer); its gains and covariances (which this explorer does not draw) stay the
+    engine's.
+    """
+    return with_student_estimates(experiments.track(scenario, SENSORS, noise=noise), filter)
+
+
+def _compensated(delayed: experiments.DelayedTracking,
+                 compensate: Callable | None) -> experiments.DelayedTracking:
+    """``delayed`` with its predictions made by ``compensate`` (if given)."""
+    if compensate is None:
+        return delayed
+    name = student_code.function_name(compensate)
+    estimates = delayed.tracking.result.estimates
+    steps = delayed.steps
+    output = student_code.call(compensate, estimates, delayed.tracking.scenario.A, steps,
+                               name=name, where=f"the explorer's trial with δ = {steps}",
+                               arg_names=_COMPENSATE_ARGS, rerun="run the explorer's cell again")
+    predictions = student_code.result_array(output, name=name, shape=estimates.shape,
+                                            allow_nan=True,
+                                            what=f"z*, shape {estimates.shape}")
+    missing = ~np.all(np.isfinite(predictions[steps:]), axis=-1)
+    if missing.any():
+        raise student_code.StudentCodeError(
+            f"{name} returned NaN in row {steps + int(np.argmax(missing))} with δ = {steps}: "
+            f"eq. (7) gives a prediction in every row j >= δ")
+    return dataclasses.replace(delayed, predictions=predictions)
+
+
+def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking,
+                   compensate: Callable | None, who: str) -> str:
     """:func:`draw_delay` for a filter run already made (the delay only shifts it)."""
     scenario = tracking.scenario
-    delayed = experiments.delay_and_compensate(tracking, delay)
+    delayed = _compensated(experiments.delay_and_compensate(tracking, delay), compensate)
     steps = delayed.steps
     mse_now = float(tracking.mse())
     mse_delayed = float(delayed.mse("delayed"))
@@ -149,8 +229,8 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking)
         # The same span every time, resized (a new one would force a full repaint).
         span.set_width(steps * scenario.dt)
         span.set_visible(steps > 0)
-    return (f"Delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps). MSE of this run: "
-            f"delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
+    return (f"Delay d = {steps * scenario.dt:.2f} s (δ = {steps} steps). MSE of this run "
+            f"({who}): delayed {mse_delayed:.2f} cm², compensated {mse_predicted:.2f} cm², "
             f"no delay {mse_now:.2f} cm².")
 
 
@@ -187,7 +267,8 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     return _Panels((top, bottom), lines, spans)
 
 
-def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
+def explore_delay(scenario: Scenario = DEFAULT, *, filter: Callable | None = None,
+                  compensate: Callable | None = None) -> Explorer:
     """Slider for the visual delay d (s) over one fixed draw of vision noise.
 
     The slider runs from 0 to :data:`MAX_DELAY` (or the last whole step before the
@@ -196,18 +277,31 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
     drawn from the scenario's explorer seed (another draw than the tasks',
     :func:`~lqe_helpers.explorers.base.with_explorer_seed`).
 
+    Parameters
+    ----------
+    scenario : Scenario
+        Constants of the simulation.
+    filter : callable, optional
+        The student's ``my_filter`` (notebook 01), run once on the explorer's readings
+        in place of the pack's engine.
+    compensate : callable, optional
+        The student's ``compensate`` (notebook 05, Task 1), run at every move in place
+        of the pack's eq. (7).
+
     Raises
     ------
     ValueError
-        If ``scenario.delay`` lies beyond the slider's range.
+        If ``scenario.delay`` lies beyond the slider's range, or ``filter`` or
+        ``compensate`` is neither None nor a function.
     """
+    _check_functions(filter, compensate)
     high = math.floor(min(MAX_DELAY, (scenario.n_steps - 1) * scenario.dt) / scenario.dt
                       + 1e-9) * scenario.dt
     start = starting_value("delay", scenario.delay, 0.0, high, "s")
     noise = with_explorer_seed(scenario).unit_noise(sensors=SENSORS)
     # A delay changes only when the filter's output arrives, not the output itself:
     # filter the fixed noise once, keep it, and let the slider shift and predict it.
-    run = LastResults(partial(experiments.track, scenario, SENSORS, noise=noise))
+    run = LastResults(partial(_filter_run, scenario, noise, filter))
     decimals = max(2, math.ceil(-math.log10(scenario.dt) - 1e-9))
     slider = float_slider("delay (s)", value=start, low=0.0, high=high,
                           step=scenario.dt, readout_format=f".{decimals}f")
@@ -215,7 +309,7 @@ def explore_delay(scenario: Scenario = DEFAULT) -> Explorer:
         "Sensory delay and its compensation: truth, delayed vision, delayed estimate and "
         "prediction",
         {"delay": slider},
-        partial(_draw, run=run),
+        partial(_draw, run=run, compensate=compensate, who=_whose(filter, compensate)),
         figsize=(9.0, 5.2),
         describe=partial(describe_delay, scenario=scenario),
     )
@@ -230,9 +324,9 @@ def describe_delay(*, delay: float, scenario: Scenario = DEFAULT) -> str:
             f"prediction, with both estimates' errors below.")
 
 
-def _draw(figure: Figure, *, delay: float,
-                  run: Callable[[], experiments.Tracking]) -> str:
+def _draw(figure: Figure, *, delay: float, run: Callable[[], experiments.Tracking],
+          compensate: Callable | None, who: str) -> str:
     """Round the slider's float to the nearest whole step, then draw the kept run."""
     tracking = run()
     dt = tracking.scenario.dt
-    return _draw_tracking(figure, round(delay / dt) * dt, tracking)
+    return _draw_tracking(figure, round(delay / dt) * dt, tracking, compensate, who)
