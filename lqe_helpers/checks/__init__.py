@@ -17,7 +17,8 @@ One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exp
 every ``check_…`` and the tolerances:
 
 - ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
+  (02, with ``initial_covariance_further``), ``fusion`` (03), ``noisier_proprioception``
+  (04), ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -29,7 +30,21 @@ from .background import check_covariance_step, check_transition_matrix
 from .bias import check_bias_model
 from .delay import check_compensation, check_delay_difference, check_delay_mse
 from .fusion import check_fusion
-from .initial_covariance import check_convergence_time, check_initial_covariance
+from .initial_covariance import (
+    check_convergence_times,
+    check_initial_covariance,
+    check_initial_covariances,
+    check_start_and_after,
+    check_start_of_trial,
+)
+from .initial_covariance_further import (
+    BOOTSTRAP_ATOL,
+    check_convergence_intervals,
+    check_first_gains,
+    check_flight_scales,
+    check_overconfidence,
+    check_p0_sweep,
+)
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -43,6 +58,7 @@ from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
 
 __all__ = [
+    "BOOTSTRAP_ATOL",
     "FUNCTION_RTOL",
     "INTERVAL_RTOL",
     "MATRIX_RTOL",
@@ -52,15 +68,23 @@ __all__ = [
     "CheckFailed",
     "check_bias_model",
     "check_compensation",
-    "check_convergence_time",
+    "check_convergence_intervals",
+    "check_convergence_times",
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
     "check_filter",
+    "check_first_gains",
+    "check_flight_scales",
     "check_fusion",
     "check_initial_covariance",
+    "check_initial_covariances",
     "check_mse",
+    "check_overconfidence",
+    "check_p0_sweep",
     "check_paired_difference",
+    "check_start_and_after",
+    "check_start_of_trial",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",
