@@ -290,7 +290,8 @@ def hand_gains(P0: np.ndarray, *, carry: str = "eq. (5)", r: float = DEFAULT.sig
         gains[j] = K[:, 0]
         corrected = P - K @ C @ P
         P = {"eq. (5)": A @ corrected @ A.T + Q, "no A": corrected + Q,
-             "no Q": A @ corrected @ A.T, "not carried": P}[carry]
+             "no Q": A @ corrected @ A.T, "not carried": P,
+             "no correction": A @ P @ A.T + Q}[carry]
     return gains
 
 
@@ -308,6 +309,8 @@ def test_check_first_gains_passes_the_worked_solution(capsys) -> None:
      "K₂ was computed from P0 again"),
     (hand_gains(P0_SMALL), hand_gains(P0_LARGE, carry="no Q"), "Q is missing from P₁"),
     (hand_gains(P0_SMALL, carry="no A"), hand_gains(P0_LARGE), "A is missing from P₁"),
+    (hand_gains(P0_SMALL), hand_gains(P0_LARGE, carry="no correction"),
+     "P₁ misses the correction −K₁CP0"),
     (hand_gains(P0_SMALL, r=DEFAULT.sigma_v), hand_gains(P0_LARGE),
      "R holds σ_v (cm) where its variance σ_v² (cm²) belongs"),
     (hand_gains(P0_SMALL).T, hand_gains(P0_LARGE), "gains_small has shape (3, 2): it is "

@@ -110,37 +110,40 @@ def check_flight_scales(initial_error: np.ndarray, flight_scales: np.ndarray) ->
 # 2. The first two gains, by hand
 # ------------------------------------------------------------------------------------------
 
-def _hand_gains(P0: np.ndarray, R: np.ndarray, carry: str) -> np.ndarray:
-    """K₁ and K₂ (2, 3) of eq. (5) with the covariance carried to step 2 as ``carry`` says."""
+def _engine_gains(P0: np.ndarray, *, A: np.ndarray | None = None, Q: np.ndarray | None = None,
+                  R: np.ndarray | None = None) -> np.ndarray:
+    """K₁ and K₂ (2, 3) from the pack's engine, with the model's A, Q or R replaced if given.
+
+    The gains do not depend on the readings, so two zero readings give them. The likely
+    mistakes come from the engine too: no readable eq. (5) in the package.
+    """
     model = experiments.filter_model(DEFAULT)
-    A, C, Q = model.A, model.C, model.Q
-    K1 = P0 @ C.T @ np.linalg.inv(C @ P0 @ C.T + R)
-    corrected = P0 - K1 @ C @ P0
-    P1 = {"as eq. (5)": A @ corrected @ A.T + Q, "not carried": P0,
-          "without Q": A @ corrected @ A.T,
-          "without A": corrected + Q, "without the correction": A @ P0 @ A.T + Q}[carry]
-    K2 = P1 @ C.T @ np.linalg.inv(C @ P1 @ C.T + R)
-    return np.array([K1[:, 0], K2[:, 0]])
+    return experiments.FilterModel(
+        model.A if A is None else A, model.C, model.Q if Q is None else Q,
+        model.R if R is None else R, model.z0, P0).filter(np.zeros((2, 1))).gains[:, :, 0]
 
 
 @functools.cache
 def _gains() -> dict[str, object]:
     """The engine's K₁ and K₂ from both P0, shape (2 P0, 2 gains, 3), and the mistakes."""
     right = question_runs().result.gains[0, :, :2, :, 0]
-    sigma_v = DEFAULT.sigma_v
+    model = experiments.filter_model(DEFAULT)
     mistakes = []
-    for p0 in QUESTION_P0:
-        P0, R = p0 * np.eye(3), np.array([[sigma_v**2]])
+    for index, p0 in enumerate(QUESTION_P0):
+        P0 = p0 * np.eye(3)
+        first = right[index, 0]
+        # P₁ = A P0 Aᵀ + Q (no correction): its gain is the first gain of a filter from it.
+        uncorrected = _engine_gains(model.A @ P0 @ model.A.T + model.Q)[0]
         mistakes.append({
             "K₂ was computed from P0 again: carry P to the next step with the last line of "
-            "eq. (5) first": _hand_gains(P0, R, "not carried"),
-            "Q is missing from P₁ = A(P0 − K₁CP0)Aᵀ + Q": _hand_gains(P0, R, "without Q"),
+            "eq. (5) first": np.array([first, first]),
+            "Q is missing from P₁ = A(P0 − K₁CP0)Aᵀ + Q": _engine_gains(P0, Q=np.zeros((3, 3))),
             "A is missing from P₁ = A(P0 − K₁CP0)Aᵀ + Q: the covariance must be carried "
-            "through the motion model": _hand_gains(P0, R, "without A"),
+            "through the motion model": _engine_gains(P0, A=np.eye(3)),
             "P₁ misses the correction −K₁CP0: P₁ = A(P0 − K₁CP0)Aᵀ + Q":
-                _hand_gains(P0, R, "without the correction"),
+                np.array([first, uncorrected]),
             "R holds σ_v (cm) where its variance σ_v² (cm²) belongs":
-                _hand_gains(P0, np.array([[sigma_v]]), "as eq. (5)"),
+                _engine_gains(P0, R=np.array([[DEFAULT.sigma_v]])),
         })
     return {"right": right, "mistakes": mistakes}
 
