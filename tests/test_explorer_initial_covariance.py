@@ -7,7 +7,6 @@ import html
 
 import numpy as np
 import pytest
-import reference_loops as reference
 from explorer_checks import EXPLORER_SCENARIO, assert_only_numbers_change, band_matches, line, png
 from matplotlib.figure import Figure
 
@@ -179,8 +178,14 @@ def test_scenario_outside_the_slider_range_is_refused(p0_variance: float) -> Non
 
 
 def my_filter(y, A, C, Q, R, z0, P0):
-    """A correct student's filter: the eq. (5) loop of the test oracle."""
-    return reference.lqe_filter(y, A, C, Q, R, z0, P0)
+    """A correct student's filter. (This file ships to students, so it wraps the engine
+    rather than spell out eq. (5), notebook 01's task.)"""
+    return experiments.FilterModel(A, C, Q, R, z0, P0).filter(y).estimates
+
+
+def shifted_filter(y, A, C, Q, R, z0, P0):
+    """A student's filter whose positions are 0.5 cm too high: what it returns is drawn."""
+    return my_filter(y, A, C, Q, R, z0, P0) + np.array([0.5, 0.0, 0.0])
 
 
 def test_the_students_filter_draws_what_the_engine_computes() -> None:
@@ -198,6 +203,19 @@ def test_the_students_filter_draws_what_the_engine_computes() -> None:
             bands = [[path.vertices for path in ax.collections[0].get_paths()]
                      for ax in (ours.axes[column], theirs.axes[column])]
             np.testing.assert_allclose(bands[0][0], bands[1][0], rtol=1e-9, atol=1e-9)
+
+
+def test_the_explorer_draws_what_the_students_filter_returns() -> None:
+    """The estimate and its MSEs come from the student's function, the band from the engine."""
+    shifted, engine = Figure(), Figure()
+    numbers = ic.draw_initial_covariance(shifted, p0_variance=1.0, filter=shifted_filter)
+    ic.draw_initial_covariance(engine, p0_variance=1.0)
+    np.testing.assert_allclose(line(shifted.axes[0], ic.ESTIMATE_LABEL),
+                               line(engine.axes[0], ic.ESTIMATE_LABEL) + 0.5, atol=1e-9)
+    positions = experiments.track(DEFAULT, p0_variance=1.0).positions + 0.5  # draw's default
+    late = metrics.mse(positions, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
+    assert numbers.startswith("Your shifted_filter, P0 = 1 · I. ")
+    assert numbers.endswith(f"{late:.2f} cm² after.")
 
 
 def test_an_explorer_of_the_students_filter_says_whose_it_is() -> None:
@@ -221,7 +239,7 @@ def not_written_filter(y, A, C, Q, R, z0, P0):
 
 def wrong_shape_filter(y, A, C, Q, R, z0, P0):
     """Returns the positions only."""
-    return reference.lqe_filter(y, A, C, Q, R, z0, P0)[:, 0]
+    return my_filter(y, A, C, Q, R, z0, P0)[:, 0]
 
 
 @pytest.mark.parametrize(("function", "phrase"), [
