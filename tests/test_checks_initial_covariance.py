@@ -406,7 +406,8 @@ def sweep() -> dict[str, np.ndarray]:
 def test_check_p0_sweep_passes_the_worked_solution(capsys, sweep) -> None:
     line = assert_passes(capsys, checks.check_p0_sweep, sweep["start"], sweep["after"],
                          sweep["times"])
-    assert "at each of the 17 values of p0" in line
+    assert "have the grid's shape and match 300 runs of the pack's engine at p0 = 0.01, 1, " \
+           "1000, 100000, 1e+06" in line
 
 
 def test_check_p0_sweep_names_each_typical_mistake(sweep) -> None:
@@ -414,14 +415,18 @@ def test_check_p0_sweep_names_each_typical_mistake(sweep) -> None:
     whole = metrics.mse(sweep["positions"], TRUTH[:, 0])
     one_run = np.array([hand_convergence_time(curve, DT) for curve in sweep["squared"][0]])
     cases = [
-        ("sweep_start is not right: it is over the whole trial", (whole, after, times)),
-        ("sweep_after is not right: it is over the whole trial", (start, whole, times)),
-        ("sweep_start is not right: it is the MSE after the first second", (after, start, times)),
+        ("sweep_start (at p0 = 0.01, 1, 1000, 100000, 1e+06) is not right: it is over the "
+         "whole trial", (whole, after, times)),
+        ("1e+06) is not right: it is over the whole trial: leave out", (start, whole, times)),
+        ("it is the MSE after the first second; sweep_start", (after, start, times)),
+        ("sweep_start must have shape (300, 17)", (start[:, ::2], after, times)),
+        ("sweep_times must have shape (17,)", (start, after, times[::2])),
         ("sweep_start has shape (17, 300): it is transposed", (start.T, after, times)),
         ("sweep_after holds one number per p0", (start, after.mean(axis=0), times)),
-        ("sweep_start is not right: it is the root mean squared error",
+        ("is not right: it is the root mean squared error",
          (np.sqrt(start), after, times)),
-        ("sweep_times is not right: the times are in samples", (start, after, times / DT)),
+        ("sweep_times (at p0 = 0.01, 1, 1000, 100000, 1e+06) is not right: the times are in "
+         "samples", (start, after, times / DT)),
         ("the convergence times of one run (run 0)", (start, after, one_run)),
     ]
     for phrase, answer in cases:

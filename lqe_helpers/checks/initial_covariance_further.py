@@ -50,6 +50,11 @@ BOOTSTRAP_ATOL = 0.02
 #: The grid of Going further 5: p0 in P0 = p0 · I (cm², cm²/s², cm²/s⁴), 2 per decade.
 P0_GRID = np.logspace(-2, 6, 17)
 P0_GRID.setflags(write=False)
+#: The columns of :data:`P0_GRID` that :func:`check_p0_sweep` recomputes: both ends, the
+#: question's two values and p0 = 10³ between them. All 17 would take the engine over a
+#: second; every column comes out of the same student code, and the runs of these five
+#: are the very runs of the whole grid (the noise of run r is the same for every p0).
+SWEEP_CHECKED = (0, 4, 10, 14, 16)
 
 
 # ------------------------------------------------------------------------------------------
@@ -360,8 +365,9 @@ def check_convergence_intervals(convergence_small: metrics.Interval,
 
 @functools.cache
 def _sweep() -> dict[str, object]:
-    """MSEs (runs, s) and convergence times (s,) over :data:`P0_GRID`, with the mistakes."""
-    sweep = experiments.track(DEFAULT, p0_variance=P0_GRID, runs=DEFAULT.mc_runs)
+    """MSEs (runs, 5) and convergence times (5,) at :data:`SWEEP_CHECKED`, and the mistakes."""
+    sweep = experiments.track(DEFAULT, p0_variance=P0_GRID[list(SWEEP_CHECKED)],
+                              runs=DEFAULT.mc_runs)
     burn, dt = DEFAULT.burn_in_steps, DEFAULT.dt
     squared = (sweep.positions - DEFAULT.truth[:, 0]) ** 2          # (runs, s, n)
     start, after = squared[..., :burn].mean(-1), squared[..., burn:].mean(-1)
@@ -405,11 +411,12 @@ def check_p0_sweep(sweep_start: np.ndarray, sweep_after: np.ndarray,
                    sweep_times: np.ndarray) -> None:
     """Check Going further 5: MSEs and convergence times over the grid of p0.
 
-    Recomputed before looking at the student's values: ``DEFAULT.mc_runs`` runs from
-    P0 = p0 · I for each p0 of :data:`P0_GRID` (one call of
-    :func:`~lqe_helpers.experiments.track`), each run's position MSE over the first
-    second and after it (within :data:`MSE_RTOL` relative), and the convergence time of
-    the Monte Carlo mean squared error for each p0 (within :data:`TIME_ATOL` s).
+    Recomputed before looking at the student's values, at the five values of p0 in
+    :data:`SWEEP_CHECKED` (the grid's ends, the question's two values, p0 = 10³):
+    ``DEFAULT.mc_runs`` runs from P0 = p0 · I (:func:`~lqe_helpers.experiments.track`),
+    each run's position MSE over the first second and after it (within :data:`MSE_RTOL`
+    relative), and the convergence time of the Monte Carlo mean squared error (within
+    :data:`TIME_ATOL` s). The arrays must have the whole grid's shape.
 
     Parameters
     ----------
@@ -426,7 +433,9 @@ def check_p0_sweep(sweep_start: np.ndarray, sweep_after: np.ndarray,
         one run or averaged over runs.
     """
     right = _sweep()
-    runs, size = right["start"].shape
+    runs, size = right["start"].shape[0], P0_GRID.size
+    columns = list(SWEEP_CHECKED)
+    at = "at p0 = " + ", ".join(f"{p0:g}" for p0 in P0_GRID[columns])
     for name, value, key in (("sweep_start", sweep_start, "start"),
                              ("sweep_after", sweep_after, "after")):
         array = argument_array(value, name, f"an array of shape ({runs}, {size}) (cm²)")
@@ -437,12 +446,19 @@ def check_p0_sweep(sweep_start: np.ndarray, sweep_after: np.ndarray,
             raise CheckFailed(f"{name} holds one number per p0 (the mean over the runs?). "
                               f"Keep one MSE per run, shape ({runs}, {size}): the intervals "
                               f"and the paired comparisons need them")
-        judge(name, array, right[key], MSE_RTOL, unit="cm²",
+        if array.shape != (runs, size):
+            raise CheckFailed(f"{name} must have shape ({runs}, {size}) (one row per run, one "
+                              f"column per p0), got {array.shape}")
+        judge(f"{name} ({at})", array[:, columns], right[key], MSE_RTOL, unit="cm²",
               what=f"the per-run MSEs {'over' if key == 'start' else 'after'} the first "
-                   f"second over the grid, recomputed with the pack's engine",
+                   f"second, recomputed with the pack's engine",
               mistakes=right[f"{key}_mistakes"])
-    judge_seconds("sweep_times", sweep_times, right["times"], right["time_mistakes"],
-                  "the convergence times of the Monte Carlo mean over the grid")
-    passed(f"sweep_start, sweep_after and sweep_times match {runs} runs of the pack's engine "
-           f"at each of the {size} values of p0: MSEs to {tolerance_text(MSE_RTOL)} relative, "
-           f"times to {tolerance_text(TIME_ATOL)} s")
+    times = argument_array(sweep_times, "sweep_times", f"an array of shape ({size},) (s)")
+    if times.shape != (size,):
+        raise CheckFailed(f"sweep_times must have shape ({size},), one time per p0, got "
+                          f"{times.shape}")
+    judge_seconds(f"sweep_times ({at})", times[columns], right["times"],
+                  right["time_mistakes"], "the convergence times of the Monte Carlo mean")
+    passed(f"sweep_start, sweep_after and sweep_times have the grid's shape and match "
+           f"{runs} runs of the pack's engine {at}: MSEs to {tolerance_text(MSE_RTOL)} "
+           f"relative, times to {tolerance_text(TIME_ATOL)} s")
