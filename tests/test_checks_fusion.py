@@ -1,12 +1,22 @@
-"""Checks of notebook 03: C and R for two senses; the worked answer passes, slips fail."""
+"""Checks of notebook 03's core tasks: the worked answers pass, realistic slips fail saying why.
+
+The wrong answers are written here as a student would write them (the task's own code with
+one slip), independently of the mistakes :mod:`lqe_helpers.checks.fusion` computes to
+recognise them. The worked filter is the test oracle ``reference_loops`` (outside the
+package). The Going further checks are tested in ``test_checks_fusion_further.py``.
+"""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
+import reference_loops as reference
 from check_outcomes import assert_fails, assert_passes
 
-from lqe_helpers import checks, model
+from lqe_helpers import checks, experiments, metrics, model
+from lqe_helpers.scenario import DEFAULT
 
 C_FUSED = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
 
@@ -50,3 +60,158 @@ def test_check_fusion_names_each_typical_mistake(C, R, phrase: str) -> None:
 ])
 def test_check_fusion_names_a_bad_argument(C, R, sigma_v, phrase: str) -> None:
     assert_fails(phrase, checks.check_fusion, C, R, sigma_v, 4.5)
+
+
+# ------------------------------------------------------------------------------------------
+# Task 2: one trial filtered both ways (the worked filter is the oracle reference_loops)
+# ------------------------------------------------------------------------------------------
+
+FUSED = ("vision", "proprioception")
+SIGMA = 1.5
+
+
+def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
+    """Task 2 as a student writes it, with their filter, optionally with one slip."""
+    trial = experiments.track(DEFAULT, FUSED)
+    y, truth, burn = trial.measurements, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
+    A, Q, z0, P0 = DEFAULT.A, DEFAULT.Q, np.zeros(3), np.eye(3)
+    C = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+    R = np.diag([SIGMA**2, SIGMA**2])
+    fused_all = reference.lqe_filter(y, A, C, Q, R, z0, P0)
+    vision_all = reference.lqe_filter(y[:, :1], A, C[:1], Q, R[:1, :1], z0, P0)
+    fused, vision = fused_all[:, 0], vision_all[:, 0]
+    if mistake == "proprioception column":
+        vision = reference.lqe_filter(y[:, 1:], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]
+    if mistake == "velocity":
+        fused = fused_all[:, 1]
+    if mistake == "averaged readings":
+        fused = reference.lqe_filter(y.mean(axis=1, keepdims=True), A, C[:1], Q, R[:1, :1], z0,
+                                     P0)[:, 0]
+    if mistake == "sigma in R":
+        fused = reference.lqe_filter(y, A, C, Q, np.diag([SIGMA, SIGMA]), z0, P0)[:, 0]
+    if mistake == "swapped":
+        fused, vision = vision, fused
+    if mistake == "all states":
+        fused = fused_all
+    start = 1 if mistake == "burn-in in seconds" else 0 if mistake == "whole trial" else burn
+    mse_fused = np.mean((fused[start:] - truth[start:]) ** 2) if fused.ndim == 1 else 0.0
+    mse_vision = np.mean((vision[start:] - truth[start:]) ** 2)
+    if mistake == "rmse":
+        mse_fused = np.sqrt(mse_fused)
+    if mistake == "readings' MSE":
+        mse_vision = np.mean((y[burn:, 0] - truth[burn:]) ** 2)
+    if mistake == "fused MSE twice":
+        mse_vision = mse_fused
+    return vision, fused, mse_vision, mse_fused
+
+
+def test_check_fusion_trial_passes_the_worked_solution(capsys) -> None:
+    line = assert_passes(capsys, checks.check_fusion_trial, *task2())
+    assert line == ("✓ both filters' positions match the pack's engine on the task's trial to "
+                    "1e-9 of the largest, and both MSEs (after the first 100 samples) to 1e-6 "
+                    "relative")
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("proprioception column", "vision_positions is not right: it is the filter run on "
+                              "proprioception's readings (column 1 of y)"),
+    ("velocity", "fused_positions is not right: it is column 1 of the estimates, the velocity"),
+    ("averaged readings", "fused_positions is not right: the two readings were averaged and "
+                          "filtered as one sense"),
+    ("sigma in R", "fused_positions is not right: R holds σ (cm) where the variance σ² (cm²) "
+                   "belongs"),
+    ("swapped", "vision_positions is not right: it is the fused filter's estimate"),
+    ("all states", "fused_positions has shape (1000, 3): it holds 3 column(s) of estimates"),
+    ("whole trial", "mse_vision_trial = 0.363507 cm²"),
+    ("whole trial", "is not right: it is the MSE of the whole trial: the first 100 samples"),
+    ("burn-in in seconds", "it leaves out the first 1 sample(s): the burn-in is 1 s"),
+    ("rmse", "mse_fused_trial = 0.39"),
+    ("rmse", "is not right: it is the root mean squared error (RMSE, in cm)"),
+    ("readings' MSE", "mse_vision_trial = 2.03754 cm²"),
+    ("readings' MSE", "it is the MSE of vision's raw readings, not of the filter's estimate"),
+    ("fused MSE twice", "mse_vision_trial = 0.15961 cm² is not right: it is the MSE of the "
+                        "fused filter's estimate"),
+])
+def test_check_fusion_trial_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_fusion_trial, *task2(mistake))
+
+
+def test_check_fusion_trial_refuses_what_is_not_a_position_array() -> None:
+    vision, fused, mse_vision, mse_fused = task2()
+    assert_fails("vision_positions must be the estimated positions (cm), an array of shape "
+                 "(1000,), got None", checks.check_fusion_trial, None, fused, mse_vision,
+                 mse_fused)
+    assert_fails("mse_fused_trial must be one number (cm²), got an array of shape (2,)",
+                 checks.check_fusion_trial, vision, fused, mse_vision,
+                 np.array([mse_fused, mse_fused]))
+    assert_fails("mse_fused_trial is NaN", checks.check_fusion_trial, vision, fused,
+                 mse_vision, float("nan"))
+
+
+# ------------------------------------------------------------------------------------------
+# Task 3: many trials, compared pair by pair
+# ------------------------------------------------------------------------------------------
+
+
+def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object, object]:
+    """Task 3 as a student writes it, optionally with one slip."""
+    runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
+    vision_mc = experiments.track(DEFAULT, ("vision",), runs=runs)
+    fused_mc = experiments.track(DEFAULT, FUSED, runs=runs)
+    start = 1 if mistake == "burn-in in seconds" else burn
+    mse_vision = metrics.mse(vision_mc.positions, truth, start)
+    mse_fused = metrics.mse(fused_mc.positions, truth, start)
+    whole_vision = metrics.mse(vision_mc.positions, truth)
+    whole_fused = metrics.mse(fused_mc.positions, truth)
+    difference = metrics.mean_ci95(mse_vision - mse_fused)
+    whole_difference = metrics.mean_ci95(whole_vision - whole_fused)
+    if mistake == "windows swapped":
+        difference, whole_difference = whole_difference, difference
+    if mistake == "fused minus vision":
+        difference = metrics.mean_ci95(mse_fused - mse_vision)
+    if mistake == "two intervals combined":
+        alone_v, alone_f = metrics.mean_ci95(mse_vision), metrics.mean_ci95(mse_fused)
+        difference = metrics.Interval(alone_v.mean - alone_f.mean, alone_v.low - alone_f.high,
+                                      alone_v.high - alone_f.low, runs)
+    if mistake == "percent":
+        whole_difference = metrics.mean_ci95(100 * (whole_vision - whole_fused) / whole_vision)
+    if mistake == "means only":
+        difference = mse_vision.mean() - mse_fused.mean()
+    if mistake == "one run":
+        mse_vision = float(metrics.mse(vision_mc.positions[0], truth, burn))
+    if mistake == "whole-trial MSEs":
+        mse_vision, mse_fused = whole_vision, whole_fused
+    return mse_vision, mse_fused, difference, whole_difference
+
+
+def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
+    line = assert_passes(capsys, checks.check_fusion_difference, *task3())
+    assert "over 300 runs match the pack's engine to 1e-6" in line
+    assert "after the first second and over the whole trial" in line
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("windows swapped", "difference is not right: it is the difference over the whole trial"),
+    ("fused minus vision", "difference is not right: the sign is reversed"),
+    ("two intervals combined", "difference is not right: it combines the two separate "
+                               "intervals"),
+    ("percent", "whole_difference is not right: it is the relative difference in % of the "
+                "vision-only MSE"),
+    ("means only", "difference is a number; it must be the metrics.Interval"),
+    ("one run", "mse_vision is one number; the task asks for one MSE per run, shape (300,)"),
+    ("whole-trial MSEs", "mse_vision is not right: it is the MSE of the whole trial"),
+    ("burn-in in seconds", "mse_vision is not right: it leaves out the first 1 sample(s)"),
+])
+def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_fusion_difference, *task3(mistake))
+
+
+def test_check_fusion_difference_uses_the_vision_only_runs_of_the_same_noise() -> None:
+    """Pairing is what the check recomputes: vision-only runs on another draw fail."""
+    _, mse_fused, _, whole_difference = task3()
+    other = experiments.track(dataclasses.replace(DEFAULT, seed=DEFAULT.seed + 1), ("vision",),
+                              runs=DEFAULT.mc_runs)
+    unpaired = metrics.mse(other.positions, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
+    assert_fails("mse_vision does not match the vision-only MSEs recomputed from the task's "
+                 "runs", checks.check_fusion_difference, unpaired, mse_fused,
+                 metrics.mean_ci95(unpaired - mse_fused), whole_difference)

@@ -405,6 +405,8 @@ def task3(slip: str = "") -> dict:
                                                     a.high - b.low, a.runs)
         elif slip == "difference of means":
             improvement[sigma_v] = raw.mean() - est.mean()
+        elif slip == "rows":                        # row i (one run, both σ_v), not column i
+            improvement[sigma_v] = metrics.mean_ci95(mse_raw[i] - mse_est[i])
         else:
             improvement[sigma_v] = metrics.mean_ci95(raw - est)
     return improvement
@@ -422,6 +424,7 @@ def test_check_vision_difference_passes_the_worked_answer(capsys) -> None:
     ("ratio", "it is the interval of the ratio raw / filtered"),
     ("separate intervals", "it combines the two separate intervals"),
     ("difference of means", "improvement[1.5] is a number; it must be the metrics.Interval"),
+    ("rows", "improvement[1.5] is over 2 runs, but the task has 300"),
 ])
 def test_check_vision_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_difference, task3(slip))

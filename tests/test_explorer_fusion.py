@@ -1,9 +1,11 @@
-"""The fusion explorer of notebook 03 draws what a plain filter run computes, on fixed noise."""
+"""The fusion explorer of notebook 03 draws what a plain filter run computes, on fixed noise,
+with the pack's engine or with a student's own filter."""
 
 from __future__ import annotations
 
 import dataclasses
 import html
+import time
 
 import numpy as np
 import pytest
@@ -21,6 +23,7 @@ from lqe_helpers.explorers.fusion import (
 )
 from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT, Scenario
+from lqe_helpers.student_code import StudentCodeError, calling
 
 LINE_GIDS = {"vision readings", "proprioception readings", "truth", "vision-only", "fused",
              "vision-only error", "fused error"}
@@ -62,7 +65,8 @@ def _independent(sigma_v: float, sigma_p: float, noise: np.ndarray,
 
 
 def _check_figure(figure: Figure, numbers: str, sigma_v: float, sigma_p: float,
-                  noise: np.ndarray, scenario: Scenario = DEFAULT) -> None:
+                  noise: np.ndarray, scenario: Scenario = DEFAULT,
+                  whose: str = "the pack's engine") -> None:
     """``figure`` and the ``numbers`` its drawing returned show this trial, computed anew."""
     expected = _independent(sigma_v, sigma_p, noise, scenario)
     lines = _lines(figure, scenario)
@@ -83,7 +87,7 @@ def _check_figure(figure: Figure, numbers: str, sigma_v: float, sigma_p: float,
                              for gid in ("vision-only error", "fused error"))
     assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
                        f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
-                       f"fused {mse_fused:.3f} cm²."), numbers
+                       f"fused {mse_fused:.3f} cm². Filter: {whose}."), numbers
     assert figure.get_suptitle() == ""
     assert figure.axes[2].get_title() == SHARES_TITLE
 
@@ -298,3 +302,132 @@ def test_scenario_outside_the_slider_range_is_refused(field: str, value: float) 
     scenario = dataclasses.replace(DEFAULT, **{field: value})
     with pytest.raises(ValueError, match=rf"scenario\.{field} .*\[0\.5, 6\] cm, got {value:g}"):
         explore_fusion(scenario)
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own filter drives the explorer (issue 15 §4)
+# ------------------------------------------------------------------------------------------
+
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A student's filter as notebook 01 asks for it: eq. (5) as a loop with an inverse."""
+    z, P, rows = np.array(z0, dtype=float), np.array(P0, dtype=float), []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        rows.append(z)
+    return np.array(rows)
+
+
+def test_a_student_filter_draws_the_engines_picture_and_says_whose_it_is():
+    explorer = explore_fusion(filter=my_filter)
+    engine = explore_fusion()
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=FUSED)
+    for sigma_v, sigma_p in ((1.5, 1.5), (2.0, 4.5), (4.5, 0.75)):
+        for each in (explorer, engine):
+            each.sliders["sigma_v"].value = sigma_v
+            each.sliders["sigma_p"].value = sigma_p
+        # The student's lines equal the independent computation to 1e-9 ...
+        _check_figure(explorer.figure, explorer.numbers, sigma_v, sigma_p, noise,
+                      whose="your my_filter")
+        # ... and the engine's picture, line for line and bar for bar.
+        ours, theirs = _lines(explorer.figure), _lines(engine.figure)
+        for gid in LINE_GIDS:
+            np.testing.assert_allclose(ours[gid], theirs[gid], rtol=1e-9, atol=1e-9,
+                                       err_msg=gid)
+        assert _weights(explorer.figure) == pytest.approx(_weights(engine.figure), rel=1e-12)
+    assert explorer.numbers.endswith("Filter: your my_filter.")
+    assert engine.numbers.endswith("Filter: the pack's engine.")
+    assert explorer.title.endswith("(your my_filter)")
+
+
+def test_the_sliders_really_run_the_students_filter():
+    calls = []
+
+    def counted(y, A, C, Q, R, z0, P0):
+        calls.append(y.shape)
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    explorer = explore_fusion(filter=counted)
+    assert calls == [(DEFAULT.n_steps, 1), (DEFAULT.n_steps, 2)]
+    explorer.sliders["sigma_p"].value = 3.0      # the kept vision-only run is reused
+    assert calls[2:] == [(DEFAULT.n_steps, 2)]
+    explorer.sliders["sigma_v"].value = 2.0
+    assert calls[3:] == [(DEFAULT.n_steps, 1), (DEFAULT.n_steps, 2)]
+
+
+def test_a_students_wrong_filter_shows_its_own_numbers():
+    def no_update(y, A, C, Q, R, z0, P0):      # forgets to correct with the readings
+        z, rows = np.array(z0, dtype=float), []
+        for _ in y:
+            z = A @ z
+            rows.append(z)
+        return np.array(rows)
+
+    explorer = explore_fusion(filter=no_update)
+    assert explorer.problem == ""
+    assert np.all(_lines(explorer.figure)["fused"] == 0.0)
+    assert explorer.numbers.endswith("Filter: your no_update.")
+
+
+def test_a_broken_student_filter_is_one_line_and_the_next_move_tries_again():
+    state = {"broken": True}
+
+    def sometimes(y, A, C, Q, R, z0, P0):
+        if state["broken"]:
+            return y                              # shape (n, m): not the estimates
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    explorer = explore_fusion(filter=sometimes)
+    assert explorer.problem.startswith("sometimes returned an array of shape (1000, 1), not of "
+                                       "shape (1000, 3)")
+    assert "\n" not in explorer.problem and explorer.numbers == explorer.problem
+    assert explorer.png.startswith(b"\x89PNG")  # a picture, even after a failed first draw
+    state["broken"] = False
+    explorer.sliders["sigma_p"].value = 3.0
+    assert explorer.problem == ""
+    _check_figure(explorer.figure, explorer.numbers, 1.5, 3.0,
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED), whose="your sometimes")
+
+
+def test_a_filter_that_raises_names_its_line():
+    def raises(y, A, C, Q, R, z0, P0):
+        return A @ y
+
+    explorer = explore_fusion(filter=raises)
+    assert explorer.problem.startswith("raises raised ValueError: matmul")
+    assert "on the explorer's trial of vision" in explorer.problem
+
+
+def test_a_filter_not_written_yet_says_so():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError("write the filter of eq. (5)")
+
+    explorer = explore_fusion(filter=my_filter)
+    assert explorer.problem == (
+        "my_filter is not written yet: replace the line `raise NotImplementedError` with your "
+        "code, run its cell, then move a slider to try again")
+    with pytest.raises(StudentCodeError, match="my_filter is not written yet"):
+        draw_fusion(fresh_figure(), sigma_v=1.5, sigma_p=1.5, filter=my_filter)
+
+
+def test_a_hanging_filter_is_stopped(monkeypatch):
+    monkeypatch.setattr(calling, "TIME_LIMIT", 0.3)
+
+    def hangs(y, A, C, Q, R, z0, P0):
+        while True:
+            pass
+
+    start = time.monotonic()
+    explorer = explore_fusion(filter=hangs)
+    assert time.monotonic() - start < 5
+    assert explorer.problem.startswith("hangs did not return within 0.3 s")
+
+
+@pytest.mark.parametrize("bad", ["my_filter", 3, np.eye(3)])
+def test_filter_must_be_a_function(bad):
+    with pytest.raises(ValueError, match="filter must be your filter function"):
+        explore_fusion(filter=bad)
+    with pytest.raises(ValueError, match="filter must be your filter function"):
+        draw_fusion(fresh_figure(), sigma_v=1.5, sigma_p=1.5, filter=bad)

@@ -26,6 +26,7 @@ from lqe_helpers.explorers.noisier_proprioception import (
 from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT, Scenario
 from lqe_helpers.steady_state import steady_state
+from lqe_helpers.student_code import StudentCodeError
 
 TRIAL_GIDS = {"truth", "vision-only", "fused", "vision-only error", "fused error"}
 ONE_ROW = np.array([[1.0, 0.0, 0.0]])
@@ -39,7 +40,7 @@ def _filter(readings: np.ndarray, sigmas: list[float], scenario: Scenario):
 
 
 def _check_figure(figure: Figure, numbers: str, sigma_p: float, noise: np.ndarray,
-                  scenario: Scenario = DEFAULT) -> None:
+                  scenario: Scenario = DEFAULT, whose: str = "the pack's engine") -> None:
     """``figure`` and the ``numbers`` its drawing returned show this trial, computed anew."""
     sigma_v = scenario.sigma_v
     truth = scenario.truth[:, 0]
@@ -69,7 +70,7 @@ def _check_figure(figure: Figure, numbers: str, sigma_p: float, noise: np.ndarra
     assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
                        f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
                        f"fused {mse_fused:.3f} cm². Proprioception's weight in the steady "
-                       f"state: {100 * weight:.1f} %."), numbers
+                       f"state: {100 * weight:.1f} %. Estimates from {whose}."), numbers
     assert figure.get_suptitle() == ""
     assert figure.axes[2].get_title() == THEORY_TITLE
 
@@ -242,4 +243,119 @@ def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
     assert labels == ["0.3", "1", "3", "10", "30", "100"]
     assert theory_ax.get_xticklabels(minor=True) == []
     # At σ_p = 30 cm proprioception still has a weight: 2.25 / (2.25 + 900) ≈ 0.25 %.
-    assert numbers.endswith("Proprioception's weight in the steady state: 0.2 %.")
+    assert numbers.endswith("Proprioception's weight in the steady state: 0.2 %. Estimates "
+                            "from the pack's engine.")
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own filter (issue 15 §4)
+# ------------------------------------------------------------------------------------------
+
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A student's filter: notebook 01's signature and output, (n, k) estimates.
+
+    Its numbers come from the engine (this file ships with the student pack, which holds
+    no worked eq. (5)); what is tested is that the explorer runs it and draws its output.
+    """
+    return kalman_filter(y, A, C, Q, R, z0, P0).estimates
+
+
+def test_the_students_filter_drives_both_estimates_and_equals_the_engine():
+    explorer = explore_noisier_proprioception(filter=my_filter)
+    noise = EXPLORER_SCENARIO.unit_noise(sensors=FUSED)
+    _check_figure(explorer.figure, explorer.numbers, START_SIGMA_P, noise,
+                  whose="your my_filter")
+    for sigma_p in (2.0, 0.5):
+        explorer.sliders["sigma_p"].value = sigma_p
+        _check_figure(explorer.figure, explorer.numbers, sigma_p, noise, whose="your my_filter")
+    assert explorer.problem == ""
+    assert "(your my_filter)" in explorer.description
+
+
+def test_the_students_filter_is_what_the_explorer_runs():
+    """Not the engine in disguise: a filter off by a constant shows that constant."""
+    calls = []
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        calls.append(y.shape)
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates + 0.5
+
+    figure = fresh_figure()
+    draw_noisier_proprioception(figure, sigma_p=3.0, filter=my_filter)
+    lines = _lines(figure)
+    truth = DEFAULT.truth[:, 0]
+    engine = fresh_figure()
+    draw_noisier_proprioception(engine, sigma_p=3.0)
+    for gid in ("vision-only", "fused"):
+        np.testing.assert_allclose(lines[gid][1], _lines(engine)[gid][1] + 0.5, rtol=0,
+                                   atol=1e-9)
+    np.testing.assert_allclose(lines["fused error"][1], lines["fused"][1] - truth, atol=1e-12)
+    assert sorted(calls) == [(DEFAULT.n_steps, 1), (DEFAULT.n_steps, 2)]
+
+
+def test_a_broken_filter_shows_one_line_and_the_next_move_tries_again():
+    state = {"broken": False}
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        if state["broken"]:
+            return kalman_filter(y, A, C, Q, R, z0, P0).estimates[:, :, None]
+        return kalman_filter(y, A, C, Q, R, z0, P0).estimates
+
+    explorer = explore_noisier_proprioception(filter=my_filter)
+    picture = explorer.png
+    state["broken"] = True
+    explorer.sliders["sigma_p"].value = 9.0
+    assert explorer.problem.startswith("my_filter returned an array of shape (1000, 3, 1)")
+    assert explorer.problem.endswith("it must return the estimates ẑ, shape (n, k) = "
+                                     "(1000, 3) (on the explorer's trial with both senses, "
+                                     "σ_p = 9 cm)")
+    assert "\n" not in explorer.problem and explorer.numbers == explorer.problem
+    assert explorer.png == picture                       # the last picture stays
+    state["broken"] = False
+    explorer.sliders["sigma_p"].value = 10.0
+    assert explorer.problem == ""
+    _check_figure(explorer.figure, explorer.numbers, 10.0,
+                  EXPLORER_SCENARIO.unit_noise(sensors=FUSED), whose="your my_filter")
+
+
+def test_a_filter_that_raises_names_its_own_line():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        K = P0 @ C @ np.linalg.inv(R)                    # C where Cᵀ belongs
+        return K
+
+    explorer = explore_noisier_proprioception(filter=my_filter)
+    assert explorer.problem.startswith("my_filter raised ValueError")
+    assert "K = P0 @ C @ np.linalg.inv(R)" in explorer.problem
+    assert "the explorer's trial with vision alone" in explorer.problem
+    assert explorer.png.startswith(b"\x89PNG")
+
+
+def test_a_filter_not_written_yet_says_so():
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError("Replace this line with your code")
+
+    explorer = explore_noisier_proprioception(filter=my_filter)
+    assert explorer.problem.startswith("my_filter is not written yet")
+    assert "move the slider again" in explorer.problem
+
+
+def test_a_filter_that_never_returns_is_stopped(monkeypatch):
+    from lqe_helpers.student_code import calling
+
+    monkeypatch.setattr(calling, "TIME_LIMIT", 0.2)
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        while True:
+            pass
+
+    figure = fresh_figure()
+    with pytest.raises(StudentCodeError, match=r"my_filter did not return within 0\.2 s"):
+        draw_noisier_proprioception(figure, sigma_p=4.5, filter=my_filter)
+
+
+def test_filter_must_be_a_function():
+    with pytest.raises(ValueError, match="filter must be a function such as my_filter"):
+        explore_noisier_proprioception(filter="my_filter")
+    with pytest.raises(ValueError, match="filter must be a function"):
+        draw_noisier_proprioception(fresh_figure(), sigma_p=4.5, filter=np.zeros(3))

@@ -12,7 +12,9 @@ from matplotlib.figure import Figure
 
 from lqe_helpers import experiments, metrics
 from lqe_helpers.explorers import vision
+from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.student_code import calling
 
 
 @pytest.fixture
@@ -55,9 +57,9 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: flo
     # The numbers go to the line beside the figure, not into it.
     raw = metrics.mse(truth + sigma_v * noise[:, 0], truth, DEFAULT.burn_in_steps)
     filtered = np.mean((expected.positions - truth)[DEFAULT.burn_in_steps:] ** 2)
-    assert explorer.numbers == (f"σ_v = {sigma_v:.1f} cm. MSE of this run after "
-                                f"{DEFAULT.burn_in:g} s: raw vision {raw:.2f} cm², "
-                                f"filtered {filtered:.2f} cm².")
+    assert explorer.numbers == (f"σ_v = {sigma_v:.1f} cm, filtered by the pack's engine. "
+                                f"MSE of this run after {DEFAULT.burn_in:g} s: raw vision "
+                                f"{raw:.2f} cm², filtered {filtered:.2f} cm².")
     assert ax.get_title() == ""
     if sigma_v != DEFAULT.sigma_v:
         assert explorer.png != previous_png
@@ -124,7 +126,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_v (cm)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
-    assert explorer.numbers.startswith(f"σ_v = {DEFAULT.sigma_v:.1f} cm. ")
+    assert explorer.numbers.startswith(f"σ_v = {DEFAULT.sigma_v:.1f} cm, filtered by ")
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
@@ -160,5 +162,130 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     figure.clear()
     numbers = vision.draw_vision(figure, sigma_v=2.0)
     (ax,) = figure.axes
-    assert numbers.startswith("σ_v = 2.0 cm. ")
+    assert numbers.startswith("σ_v = 2.0 cm, filtered by the pack's engine. ")
     assert len(ax.get_lines()) == 3
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own filter on the slider (issue 15 §4)
+# ------------------------------------------------------------------------------------------
+
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A correct student filter (the engine's estimates, returned as the task asks)."""
+    return np.array(kalman_filter(y, A, C, Q, R, z0, P0).estimates)
+
+
+def test_the_slider_runs_the_students_filter_and_says_so() -> None:
+    calls = []
+
+    def my_filter_counted(y, A, C, Q, R, z0, P0):
+        calls.append((y.shape, R.tolist()))
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    explorer = vision.explore_vision(filter=my_filter_counted)
+    engine = vision.explore_vision()
+    for sigma_v in (1.5, 0.1, 7.3):
+        for each in (explorer, engine):
+            each.sliders["sigma_v"].value = sigma_v
+        (ours,), (theirs,) = explorer.figure.axes, engine.figure.axes
+        np.testing.assert_allclose(line(ours, vision.ESTIMATE_LABEL),
+                                   line(theirs, vision.ESTIMATE_LABEL), rtol=0, atol=1e-9)
+        assert explorer.numbers == engine.numbers.replace("the pack's engine",
+                                                          "your my_filter_counted")
+        assert explorer.problem == ""
+    assert calls[-1] == ((DEFAULT.n_steps, 1), [[7.3**2]])
+    assert "estimate of your my_filter_counted with a ±2σ band from the engine's" in (
+        explorer.description)
+
+
+def test_the_drawing_shows_what_the_students_filter_returns() -> None:
+    """Not the engine's estimate: a filter 1 cm off draws a line 1 cm off, band included."""
+    def off_by_one(y, A, C, Q, R, z0, P0):
+        return my_filter(y, A, C, Q, R, z0, P0) + 1.0
+
+    figure = Figure()
+    numbers = vision.draw_vision(figure, sigma_v=2.0, filter=off_by_one)
+    expected = experiments.track(DEFAULT, sigmas=[2.0])
+    (ax,) = figure.axes
+    np.testing.assert_allclose(line(ax, vision.ESTIMATE_LABEL), expected.positions + 1.0,
+                               rtol=0, atol=1e-9)
+    std = np.sqrt(expected.position_variances)   # the engine's covariance, data-independent
+    band_matches(ax, vision.BAND_LABEL, expected.positions + 1.0 - 2 * std,
+                 expected.positions + 1.0 + 2 * std)
+    filtered = metrics.mse(expected.positions + 1.0, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
+    assert numbers.endswith(f"filtered {filtered:.2f} cm².")
+    assert "filtered by your off_by_one." in numbers
+
+
+def test_a_broken_filter_is_one_line_and_the_next_move_tries_again() -> None:
+    state = {"broken": True}
+
+    def my_filter_draft(y, A, C, Q, R, z0, P0):
+        if state["broken"]:
+            K = P0 @ C @ np.linalg.inv(C @ P0 @ C.T + R)   # C where Cᵀ belongs: shapes clash
+            return K
+        return my_filter(y, A, C, Q, R, z0, P0)
+
+    explorer = vision.explore_vision(filter=my_filter_draft)
+    assert explorer.problem.startswith("my_filter_draft raised ValueError")
+    assert "(in my_filter_draft, line" in explorer.problem and "`K = P0 @ C @" in (
+        explorer.problem)
+    assert "\n" not in explorer.problem and explorer.numbers == explorer.problem
+    state["broken"] = False
+    explorer.sliders["sigma_v"].value = 2.5
+    assert explorer.problem == ""
+    assert explorer.numbers.startswith("σ_v = 2.5 cm, filtered by your my_filter_draft. ")
+
+
+def test_a_filter_not_written_yet_says_so() -> None:
+    def my_filter(y, A, C, Q, R, z0, P0):
+        raise NotImplementedError
+
+    explorer = vision.explore_vision(filter=my_filter)
+    assert explorer.problem.startswith("my_filter is not written yet: replace the line")
+    assert explorer.problem.endswith("run the explorer's cell again")
+    assert explorer.png.startswith(b"\x89PNG")     # a picture is still shown
+
+
+@pytest.mark.parametrize(("returned", "phrase"), [
+    (lambda est: est[:, 0], "returned an array of shape (1000,)"),
+    (lambda est: list(est), "returned a Python list"),
+    (lambda est: est + 1j, "returned complex numbers"),
+    (lambda est: None, "returned None"),
+])
+def test_a_filter_returning_the_wrong_thing_is_named(returned, phrase) -> None:
+    def my_filter_wrong(y, A, C, Q, R, z0, P0):
+        return returned(my_filter(y, A, C, Q, R, z0, P0))
+
+    with pytest.raises(vision.student_code.StudentCodeError, match=r"^my_filter_wrong ") as info:
+        vision.draw_vision(Figure(), sigma_v=1.5, filter=my_filter_wrong)
+    assert phrase in str(info.value)
+
+
+def test_an_endless_filter_is_stopped(monkeypatch) -> None:
+    monkeypatch.setattr(calling, "TIME_LIMIT", 0.2)
+
+    def my_filter(y, A, C, Q, R, z0, P0):
+        while True:
+            pass
+
+    explorer = vision.explore_vision(filter=my_filter)
+    assert explorer.problem.startswith("my_filter did not return within 0.2 s")
+
+
+def test_the_filter_gets_copies_and_cannot_spoil_the_next_draw() -> None:
+    def my_filter_in_place(y, A, C, Q, R, z0, P0):
+        estimates = my_filter(y, A, C, Q, R, z0, P0)
+        y[...] = 0.0                                   # changes its input
+        return estimates
+
+    with pytest.raises(vision.student_code.StudentCodeError, match="changed its input y"):
+        vision.draw_vision(Figure(), sigma_v=1.5, filter=my_filter_in_place)
+    numbers = vision.draw_vision(Figure(), sigma_v=1.5)
+    assert numbers == vision.draw_vision(Figure(), sigma_v=1.5)
+
+
+def test_explore_vision_refuses_a_filter_that_is_not_a_function() -> None:
+    with pytest.raises(ValueError, match=r"filter must be your filter function .* got a ndarray"):
+        vision.explore_vision(filter=np.zeros(3))

@@ -18,14 +18,15 @@ import nbformat
 import pytest
 from nbformat.v4 import new_code_cell, new_notebook
 
-from lqe_helpers.authoring import files
-from lqe_helpers.authoring.files import (
-    MANIFEST_NAME,
+from lqe_helpers.authoring import command_line, files, manifest, notebook_io, transaction
+from lqe_helpers.authoring.errors import (
     FileSafetyError,
     NotebookFileError,
     OutputFolderError,
     OutputWriteError,
 )
+from lqe_helpers.authoring.manifest import MANIFEST_NAME
+from lqe_helpers.authoring.output_folder import check_out_dir, write_output_folder
 
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
@@ -104,7 +105,7 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
     # A full disk while the second is being written: nothing replaced yet.
     monkeypatch.setattr(files, "_write_fd", full_disk_after(3))
     with pytest.raises(OSError):
-        files.atomic_write_many({first: "good after", second: "other after"})
+        transaction.atomic_write_many({first: "good after", second: "other after"})
     assert snapshot(tmp_path) == before
     monkeypatch.undo()
 
@@ -118,12 +119,12 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
 
     monkeypatch.setattr(os, "replace", replace)
     with pytest.raises(OSError):
-        files.atomic_write_many({first: "good after", second: "other after"})
+        transaction.atomic_write_many({first: "good after", second: "other after"})
     monkeypatch.undo()
     assert snapshot(tmp_path) == before
 
-    assert files.atomic_write_many({first: "good after", second: b"other after"}) == [first,
-                                                                                      second]
+    assert transaction.atomic_write_many({first: "good after",
+                                          second: b"other after"}) == [first, second]
     assert (first.read_text(), second.read_text()) == ("good after", "other after")
     assert sorted(os.listdir(tmp_path)) == ["good.ipynb", "other.ipynb"]
 
@@ -142,24 +143,24 @@ def test_a_file_that_is_not_a_notebook_is_one_clear_error(tmp_path, content, mes
     path = tmp_path / "bad.ipynb"
     path.write_bytes(content)
     with pytest.raises(NotebookFileError, match=message) as raised:
-        files.read_notebook(path)
+        notebook_io.read_notebook(path)
     assert str(raised.value).startswith(str(path))
     assert "\n" not in str(raised.value)
 
 
 def test_missing_or_folder_notebooks_are_clear_errors(tmp_path):
     with pytest.raises(NotebookFileError, match=r"missing\.ipynb: no such file"):
-        files.read_notebook(tmp_path / "missing.ipynb")
+        notebook_io.read_notebook(tmp_path / "missing.ipynb")
     with pytest.raises(NotebookFileError, match="is a folder, not a notebook"):
-        files.read_notebook(tmp_path)
+        notebook_io.read_notebook(tmp_path)
 
 
 def test_write_notebook_matches_nbformat_write(tmp_path):
     notebook = new_notebook(cells=[new_code_cell("print('é')")])
     nbformat.write(notebook, tmp_path / "reference.ipynb")
-    files.write_notebook(tmp_path / "ours.ipynb", notebook)
+    notebook_io.write_notebook(tmp_path / "ours.ipynb", notebook)
     assert (tmp_path / "ours.ipynb").read_bytes() == (tmp_path / "reference.ipynb").read_bytes()
-    assert files.read_notebook(tmp_path / "ours.ipynb") == notebook
+    assert notebook_io.read_notebook(tmp_path / "ours.ipynb") == notebook
 
 
 # --- where an output folder may be ------------------------------------------------------------
@@ -168,12 +169,12 @@ def test_an_output_folder_overlapping_the_source_is_refused(tmp_path):
     course = tmp_path / "C"
     (course / "drafts").mkdir(parents=True)
     with pytest.raises(OutputFolderError, match="contains the source folder"):
-        files.check_out_dir(course / "drafts", course)  # the case
+        check_out_dir(course / "drafts", course)  # the case
     with pytest.raises(OutputFolderError, match="lies inside the source folder"):
-        files.check_out_dir(course, course / "drafts" / "new" / "deeper")
+        check_out_dir(course, course / "drafts" / "new" / "deeper")
     with pytest.raises(OutputFolderError, match="is the source folder"):
-        files.check_out_dir(course, tmp_path / "C" / ".." / "C")
-    files.check_out_dir(course / "drafts", tmp_path / "elsewhere")  # fine
+        check_out_dir(course, tmp_path / "C" / ".." / "C")
+    check_out_dir(course / "drafts", tmp_path / "elsewhere")  # fine
 
 
 def test_another_spelling_of_the_source_folder_is_recognised(tmp_path):
@@ -182,23 +183,23 @@ def test_another_spelling_of_the_source_folder_is_recognised(tmp_path):
     alias = tmp_path / "alias"
     alias.symlink_to(course)
     with pytest.raises(OutputFolderError, match="contains the source folder"):
-        files.check_out_dir(course / "drafts", alias)
+        check_out_dir(course / "drafts", alias)
     with pytest.raises(OutputFolderError, match="lies inside the source folder"):
-        files.check_out_dir(alias, course / "drafts")
+        check_out_dir(alias, course / "drafts")
     # Where the file system ignores case, "C/DRAFTS" is "C/drafts": samefile decides.
     upper = tmp_path / "C" / "DRAFTS"
     if upper.exists():
         with pytest.raises(OutputFolderError):
-            files.check_out_dir(course / "drafts", upper)
+            check_out_dir(course / "drafts", upper)
 
 
 def test_an_output_path_that_is_a_file_is_refused(tmp_path):
     (tmp_path / "src").mkdir()
     (tmp_path / "out").write_text("a file")
     with pytest.raises(OutputFolderError, match="is a file; give a folder"):
-        files.check_out_dir(tmp_path / "src", tmp_path / "out")
+        check_out_dir(tmp_path / "src", tmp_path / "out")
     with pytest.raises(OutputFolderError, match="is a file; give a folder"):
-        files.write_output_folder(tmp_path / "out", {"a.html": "x"}, tool="t")
+        write_output_folder(tmp_path / "out", {"a.html": "x"}, tool="t")
     assert (tmp_path / "out").read_text() == "a file"
 
 
@@ -206,25 +207,26 @@ def test_an_output_path_that_is_a_file_is_refused(tmp_path):
 
 def test_a_new_folder_is_written_whole_with_its_manifest(tmp_path):
     out = tmp_path / "build" / "handouts"
-    written = files.write_output_folder(out, {"index.html": "i", "prose/a b é.html": b"p"},
-                                        tool="handouts")
+    written = write_output_folder(out, {"index.html": "i", "prose/a b é.html": b"p"},
+                                  tool="handouts")
     assert written == [out / "index.html", out / "prose" / "a b é.html"]
-    manifest = json.loads((out / MANIFEST_NAME).read_text())
-    assert manifest["tool"] == "handouts"
-    assert manifest["files"] == {"index.html": files.sha256(b"i"),
-                                 "prose/a b é.html": files.sha256(b"p")}
+    written_manifest = json.loads((out / MANIFEST_NAME).read_text())
+    assert written_manifest["tool"] == "handouts"
+    assert written_manifest["files"] == {"index.html": files.sha256(b"i"),
+                                         "prose/a b é.html": files.sha256(b"p")}
     assert sorted(os.listdir(out.parent)) == ["handouts"]  # no staging folder left
-    assert files.read_manifest(out) == files.Manifest("handouts", manifest["files"])
+    assert manifest.read_manifest(out) == manifest.Manifest("handouts",
+                                                                written_manifest["files"])
 
 
 def test_a_rebuild_replaces_and_deletes_only_its_own_unchanged_files(tmp_path):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"01_a.html": "a1", "02_old.html": "old", "index.html": "i1"},
-                              tool="handouts")
+    write_output_folder(out, {"01_a.html": "a1", "02_old.html": "old", "index.html": "i1"},
+                        tool="handouts")
     (out / "course_home.html").write_text("the instructor's own page")
     (out / "notes").mkdir()
     (out / "notes" / "x.html").write_text("notes")
-    files.write_output_folder(out, {"01_a.html": "a2", "index.html": "i2"}, tool="handouts")
+    write_output_folder(out, {"01_a.html": "a2", "index.html": "i2"}, tool="handouts")
     assert snapshot(out) == {
         MANIFEST_NAME: (out / MANIFEST_NAME).read_bytes(),
         "01_a.html": b"a2", "index.html": b"i2",  # replaced
@@ -235,19 +237,19 @@ def test_a_rebuild_replaces_and_deletes_only_its_own_unchanged_files(tmp_path):
 
 def test_a_changed_file_of_an_earlier_build_is_kept(tmp_path):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"01.ipynb": "a", "02.ipynb": "b"}, tool="student_edition")
+    write_output_folder(out, {"01.ipynb": "a", "02.ipynb": "b"}, tool="student_edition")
     (out / "01.ipynb").write_text("hand-edited by the instructor")
     (out / "02.ipynb").write_text("hand-edited too")
     before = snapshot(out)
     with pytest.raises(OutputFolderError, match=r"01\.ipynb was changed since student_edition "
                                                 r"wrote it"):
-        files.write_output_folder(out, {"01.ipynb": "new"}, tool="student_edition")
+        write_output_folder(out, {"01.ipynb": "new"}, tool="student_edition")
     assert snapshot(out) == before
     # Not written any more but changed: kept, and no longer listed as the tool's.
-    files.write_output_folder(out, {"03.ipynb": "c"}, tool="student_edition")
+    write_output_folder(out, {"03.ipynb": "c"}, tool="student_edition")
     assert (out / "01.ipynb").read_text() == "hand-edited by the instructor"
     assert (out / "02.ipynb").read_text() == "hand-edited too"
-    assert set(files.read_manifest(out).files) == {"03.ipynb"}
+    assert set(manifest.read_manifest(out).files) == {"03.ipynb"}
 
 
 def test_a_file_in_the_way_that_the_tool_did_not_write_stops_the_build(tmp_path):
@@ -257,8 +259,8 @@ def test_a_file_in_the_way_that_the_tool_did_not_write_stops_the_build(tmp_path)
     (out / "my_grading_notes.ipynb").write_text("grading notes")
     before = snapshot(out)
     with pytest.raises(OutputFolderError) as raised:
-        files.write_output_folder(out, {"index.html": "generated", "01.html": "page"},
-                                  tool="handouts")
+        write_output_folder(out, {"index.html": "generated", "01.html": "page"},
+                            tool="handouts")
     assert "index.html was not written by handouts" in str(raised.value)
     assert "Nothing was changed" in str(raised.value)
     assert snapshot(out) == before
@@ -269,26 +271,26 @@ def test_links_in_the_output_folder_are_refused(tmp_path):
     worked.mkdir()
     (worked / "01.ipynb").write_text("the worked notebook")
     out = tmp_path / "out"
-    files.write_output_folder(out, {"02.ipynb": "x"}, tool="student_edition")
+    write_output_folder(out, {"02.ipynb": "x"}, tool="student_edition")
     (out / "01.ipynb").symlink_to(worked / "01.ipynb")
     (out / "sub").symlink_to(worked)
     before, worked_before = snapshot(out), snapshot(worked)
     with pytest.raises(OutputFolderError, match=r"01\.ipynb is a symbolic link"):
-        files.write_output_folder(out, {"01.ipynb": "student"}, tool="student_edition")
+        write_output_folder(out, {"01.ipynb": "student"}, tool="student_edition")
     with pytest.raises(OutputFolderError, match="sub/ is a symbolic link"):
-        files.write_output_folder(out, {"sub/01.ipynb": "student"}, tool="student_edition")
+        write_output_folder(out, {"sub/01.ipynb": "student"}, tool="student_edition")
     assert snapshot(out) == before
     assert snapshot(worked) == worked_before
 
 
 def test_another_tools_folder_or_a_broken_manifest_is_refused(tmp_path):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"a.ipynb": "x"}, tool="student_edition")
+    write_output_folder(out, {"a.ipynb": "x"}, tool="student_edition")
     with pytest.raises(OutputFolderError, match="holds the output of student_edition"):
-        files.write_output_folder(out, {"a.html": "x"}, tool="handouts")
+        write_output_folder(out, {"a.html": "x"}, tool="handouts")
     (out / MANIFEST_NAME).write_text("{not json")
     with pytest.raises(OutputFolderError, match="is not a manifest the course tools can read"):
-        files.write_output_folder(out, {"a.ipynb": "x"}, tool="student_edition")
+        write_output_folder(out, {"a.ipynb": "x"}, tool="student_edition")
 
 
 @pytest.mark.parametrize("limit", [0, 7])
@@ -296,21 +298,21 @@ def test_another_tools_folder_or_a_broken_manifest_is_refused(tmp_path):
 def test_a_full_disk_leaves_the_output_folder_as_it_was(tmp_path, monkeypatch, limit, exists):
     out = tmp_path / "out"
     if exists:
-        files.write_output_folder(out, {"01.html": "one", "02.html": "two" * 100},
-                                  tool="handouts")
+        write_output_folder(out, {"01.html": "one", "02.html": "two" * 100},
+                            tool="handouts")
         (out / "course_home.html").write_text("mine")
     before = snapshot(tmp_path)
     monkeypatch.setattr(files, "_write_fd", full_disk_after(limit))
     with pytest.raises(OutputWriteError, match=r"No space left on device.*left as it was"):
-        files.write_output_folder(out, {"01.html": "ONE" * 100, "03.html": "three"},
-                                  tool="handouts")
+        write_output_folder(out, {"01.html": "ONE" * 100, "03.html": "three"},
+                            tool="handouts")
     assert snapshot(tmp_path) == before
 
 
 def test_a_failure_while_moving_into_place_is_undone(tmp_path, monkeypatch):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"01.html": "one", "02.html": "two", "old.html": "old"},
-                              tool="handouts")
+    write_output_folder(out, {"01.html": "one", "02.html": "two", "old.html": "old"},
+                        tool="handouts")
     before = snapshot(tmp_path)
     real_replace = os.replace
     calls = []
@@ -323,8 +325,8 @@ def test_a_failure_while_moving_into_place_is_undone(tmp_path, monkeypatch):
 
     monkeypatch.setattr(os, "replace", replace)
     with pytest.raises(OutputWriteError, match="Input/output error"):
-        files.write_output_folder(out, {"01.html": "ONE", "02.html": "TWO", "new/03.html": "3"},
-                                  tool="handouts")
+        write_output_folder(out, {"01.html": "ONE", "02.html": "TWO", "new/03.html": "3"},
+                            tool="handouts")
     monkeypatch.undo()
     assert len(calls) > 3  # the pages had been moved into place before the failure
     assert snapshot(tmp_path) == before
@@ -332,18 +334,18 @@ def test_a_failure_while_moving_into_place_is_undone(tmp_path, monkeypatch):
 
 def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"01.html": "one"}, tool="handouts")
+    write_output_folder(out, {"01.html": "one"}, tool="handouts")
     before = snapshot(tmp_path)
-    real_mkdtemp = files.tempfile.mkdtemp
+    real_mkstemp = files.tempfile.mkstemp
 
-    def read_only(*args, dir=None, **kwargs):
+    def read_only(*args, dir=None, **kwargs):  # the first file a build creates in out
         if Path(dir) == out:
             raise OSError(errno.EROFS, "Read-only file system", str(out))
-        return real_mkdtemp(*args, dir=dir, **kwargs)
+        return real_mkstemp(*args, dir=dir, **kwargs)
 
-    monkeypatch.setattr(files.tempfile, "mkdtemp", read_only)
+    monkeypatch.setattr(files.tempfile, "mkstemp", read_only)
     with pytest.raises(OutputWriteError, match=f"cannot write into {out}: Read-only file system"):
-        files.write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
+        write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
     assert snapshot(tmp_path) == before
 
 
@@ -351,12 +353,12 @@ def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
                     "simulated read-only folder above covers root")
 def test_a_really_read_only_output_folder(tmp_path):
     out = tmp_path / "out"
-    files.write_output_folder(out, {"01.html": "one"}, tool="handouts")
+    write_output_folder(out, {"01.html": "one"}, tool="handouts")
     before = snapshot(tmp_path)
     out.chmod(0o555)
     try:
         with pytest.raises(OutputWriteError, match="Permission denied"):
-            files.write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
+            write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
     finally:
         out.chmod(0o755)
     assert snapshot(tmp_path) == before
@@ -365,14 +367,14 @@ def test_a_really_read_only_output_folder(tmp_path):
 def test_output_names_must_stay_inside_the_folder(tmp_path):
     for name in ["../escape.html", "/abs.html", "a/../../b", ".lqe-build-x/a", "./a.html"]:
         with pytest.raises(ValueError, match="plain relative paths"):
-            files.write_output_folder(tmp_path / "out", {name: "x"}, tool="t")
+            write_output_folder(tmp_path / "out", {name: "x"}, tool="t")
     assert not (tmp_path / "out").exists()
 
 
 # --- command lines -----------------------------------------------------------------------------
 
 def _parser() -> argparse.ArgumentParser:
-    parser = files.CommandLineParser(prog="tool")
+    parser = command_line.CommandLineParser(prog="tool")
     parser.add_argument("--n", type=int, default=0)
     return parser
 
@@ -397,14 +399,14 @@ def _raising(error: BaseException):
      "error: first line (--verbose shows the rest)"),
 ])
 def test_every_failure_is_one_error_line_and_status_1(capsys, error, line):
-    assert files.run_command(_parser(), _raising(error), []) == 1
+    assert command_line.run_command(_parser(), _raising(error), []) == 1
     captured = capsys.readouterr()
     assert captured.err == line + "\n"
     assert captured.out == ""
 
 
 def test_verbose_adds_the_traceback(capsys):
-    assert files.run_command(_parser(), _raising(RuntimeError("boom\nline 2")),
+    assert command_line.run_command(_parser(), _raising(RuntimeError("boom\nline 2")),
                              ["--verbose"]) == 1
     err = capsys.readouterr().err
     assert err.startswith("Traceback (most recent call last):")
@@ -414,7 +416,7 @@ def test_verbose_adds_the_traceback(capsys):
 
 def test_usage_errors_warnings_and_interrupts(capsys):
     with pytest.raises(SystemExit) as raised:
-        files.run_command(_parser(), lambda args: 0, ["--n", "many"])
+        command_line.run_command(_parser(), lambda args: 0, ["--n", "many"])
     assert raised.value.code == 1
     assert capsys.readouterr().err == ("error: argument --n: invalid int value: 'many'; "
                                        "see tool --help\n")
@@ -424,8 +426,8 @@ def test_usage_errors_warnings_and_interrupts(capsys):
         warnings.warn("careful\nsecond line", UserWarning, stacklevel=1)
         return None
 
-    assert files.run_command(_parser(), warns, []) == 0
+    assert command_line.run_command(_parser(), warns, []) == 0
     assert capsys.readouterr().err == "warning: careful\n"
-    assert files.run_command(_parser(), _raising(KeyboardInterrupt()), []) == 130
+    assert command_line.run_command(_parser(), _raising(KeyboardInterrupt()), []) == 130
     assert capsys.readouterr().err == "error: interrupted\n"
-    assert files.run_command(_parser(), lambda args: None, ["--n", "2"]) == 0
+    assert command_line.run_command(_parser(), lambda args: None, ["--n", "2"]) == 0

@@ -23,7 +23,8 @@ from bs4 import BeautifulSoup
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers.authoring import files, handout_pages, handouts
-from lqe_helpers.authoring.files import MANIFEST_NAME, OutputFolderError, OutputWriteError
+from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError
+from lqe_helpers.authoring.manifest import MANIFEST_NAME
 from lqe_helpers.authoring.student_edition import EXPLORER_TAG
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"

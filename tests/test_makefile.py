@@ -22,7 +22,7 @@ from pathlib import Path
 
 import pytest
 
-from lqe_helpers.authoring import files
+from lqe_helpers.authoring.output_folder import write_output_folder
 
 ROOT = Path(__file__).resolve().parents[1]
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
@@ -87,12 +87,12 @@ def test_clean_never_deletes_another_environment_named_by_venv(pack, tmp_path, h
 
 def test_clean_removes_only_what_the_makefile_made(pack):
     build = pack / "build"
-    files.write_output_folder(build / "student", {"01.ipynb": "one", "02.ipynb": "two"},
-                              tool="student_edition")
-    files.write_output_folder(build / "handouts", {"index.html": "i", "prose/index.html": "p"},
-                              tool="handouts")
-    files.write_output_folder(build / "marking-guide", {"marking-guide.md": "m"},
-                              tool="marking_guide")
+    write_output_folder(build / "student", {"01.ipynb": "one", "02.ipynb": "two"},
+                        tool="student_edition")
+    write_output_folder(build / "handouts", {"index.html": "i", "prose/index.html": "p"},
+                        tool="handouts")
+    write_output_folder(build / "marking-guide", {"marking-guide.md": "m"},
+                        tool="marking_guide")
     (build / "student" / "02.ipynb").write_text("hand-edited after the build")
     (build / "student" / "my_grading_notes.ipynb").write_text("grading notes")
     (build / "handouts" / "course_home.html").write_text("the instructor's page")

@@ -10,6 +10,7 @@ in ``test_student_code_kernel.py``.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import threading
 import time
@@ -18,7 +19,13 @@ import numpy as np
 import pytest
 
 from lqe_helpers import metrics, student_code
-from lqe_helpers.student_code import NotWrittenYet, StudentCodeError, TimedOut, calling
+from lqe_helpers.student_code import (
+    NotSavedYet,
+    NotWrittenYet,
+    StudentCodeError,
+    TimedOut,
+    calling,
+)
 
 LIMIT = 0.3  # s: short, so that the endless loops below end soon
 
@@ -382,13 +389,21 @@ def test_save_and_load_use_my_functions_in_the_working_folder(tmp_path, monkeypa
     assert student_code.load("doubled")(3) == 6
 
 
-def test_load_names_the_notebook_that_writes_a_missing_file(tmp_path) -> None:
-    with pytest.raises(StudentCodeError, match=r"my_filter.py does not exist yet: notebook 01 "
-                                               r"\(the check after Task 1\) writes it when its "
-                                               r"check passes; run that first"):
-        student_code.load("my_filter", tmp_path)
-    with pytest.raises(StudentCodeError, match="the notebook whose task defines other"):
-        student_code.load("other", tmp_path)
+def test_load_of_a_missing_file_gives_a_stand_in_naming_the_notebook_that_writes_it(
+        tmp_path, capsys) -> None:
+    """The notebook runs on; every use of the function (a task, a check, an explorer) says
+    in one line which notebook's task saves it."""
+    expected = (r"my_filter is not saved yet: .*my_filter.py does not exist\. notebook 01 "
+                r"\(the check after Task 1\) writes it when its check passes; run that first")
+    stand_in = student_code.load("my_filter", tmp_path)
+    assert stand_in.__name__ == "my_filter"
+    assert re.search(expected, capsys.readouterr().out)
+    with pytest.raises(NotSavedYet, match=expected):
+        stand_in(np.zeros((3, 1)))
+    with pytest.raises(NotSavedYet, match=expected):  # through call: the same one line
+        student_code.call(stand_in, np.zeros((3, 1)))
+    with pytest.raises(NotSavedYet, match="the notebook whose task defines other"):
+        student_code.load("other", tmp_path)()
     with pytest.raises(ValueError, match="name must be a function's name"):
         student_code.load("../x", tmp_path)
 

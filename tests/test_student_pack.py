@@ -24,7 +24,7 @@ import pytest
 
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
-from lqe_helpers.authoring.files import OutputFolderError
+from lqe_helpers.authoring.errors import OutputFolderError
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))

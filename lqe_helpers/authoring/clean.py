@@ -3,51 +3,63 @@
 ``python -m lqe_helpers.authoring.clean build/handouts build/student ...`` deletes, in each
 folder, the files listed in its manifest (``.lqe-manifest.json``) that still hold exactly
 what the tool wrote, then the manifest and the folders left empty. A file the tools did
-not write, or one changed since, is kept and named. A folder without a manifest is left
-as it is. Needs only the standard library, so it runs even when ``.venv`` is broken.
+not write, or one changed since, is kept and named, and so is a folder named like a
+tool's temporary folder (``.lqe-build-…``) that no journal recorded. A build killed
+part-way is finished or undone first. A folder without a manifest, or whose manifest lists
+a name outside it, is left as it is (the latter with an ``error:`` line and exit status
+1). Needs only the standard library, so it runs even when ``.venv`` is broken.
 """
 
 from __future__ import annotations
 
-import argparse
-from collections.abc import Sequence
-from pathlib import Path
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-from lqe_helpers.authoring.files import (
-    MANIFEST_NAME,
-    CommandLineParser,
-    read_manifest,
-    remove_output_folder,
-    run_command,
-)
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import sys
+    from collections.abc import Sequence
+    from pathlib import Path
+
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import OutputFolderError, error_line, shown, summarise
+    from lqe_helpers.authoring.manifest import MANIFEST_NAME, read_manifest
+    from lqe_helpers.authoring.output_folder import remove_output_folder
 
 
-def clean(folders: Sequence[Path | str]) -> list[str]:
-    """Clean each output folder (:func:`~lqe_helpers.authoring.files.remove_output_folder`).
+def clean(folders: Sequence[Path | str]) -> tuple[list[str], list[str]]:
+    """Clean each output folder (:func:`~lqe_helpers.authoring.output_folder.remove_output_folder`).
+
+    A folder that cannot be cleaned safely (its manifest lists a name outside it, another
+    tool is writing it) is left entirely as it is, and the others are still cleaned.
 
     Returns
     -------
-    list of str
+    report : list of str
         One line per folder that still exists afterwards, saying what was kept and why.
+    errors : list of str
+        One line per folder left alone because cleaning it was refused.
     """
-    report = []
+    report, errors = [], []
     for folder in map(Path, folders):
-        if not folder.exists():
+        if not folder.exists() and not folder.is_symlink():
             continue
         if not folder.is_dir():
-            report.append(f"kept {folder}: a file, not an output folder")
+            report.append(f"kept {shown(folder)}: a file, not an output folder")
             continue
-        if read_manifest(folder) is None:
-            report.append(f"kept {folder}: it has no {MANIFEST_NAME}, so nothing in it is known "
-                          f"to be the tools' (delete it yourself if it is)")
+        try:
+            if read_manifest(folder) is None:
+                report.append(f"kept {shown(folder)}: it has no {MANIFEST_NAME}, so nothing in it "
+                              f"is known to be the tools' (delete it yourself if it is)")
+                continue
+            _, kept = remove_output_folder(folder)
+        except (OutputFolderError, OSError) as error:
+            errors.append(error_line(error))
             continue
-        _, kept = remove_output_folder(folder)
         if kept:
-            names = ", ".join(path.relative_to(folder).as_posix() for path in kept[:5])
-            more = f" and {len(kept) - 5} more" if len(kept) > 5 else ""
-            report.append(f"kept in {folder}: {names}{more} (not written by the tools, or "
+            names = summarise([path.relative_to(folder).as_posix() for path in kept], 5)
+            report.append(f"kept in {shown(folder)}: {names} (not written by the tools, or "
                           f"changed since)")
-    return report
+    return report, errors
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -57,9 +69,12 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("folders", nargs="+", type=Path, metavar="FOLDER")
 
     def command(args: argparse.Namespace) -> int:
-        for line in clean(args.folders):
+        report, errors = clean(args.folders)
+        for line in report:
             print(line)
-        return 0
+        for line in errors:
+            print(f"error: {line}", file=sys.stderr)
+        return 1 if errors else 0
 
     return run_command(parser, command, argv)
 

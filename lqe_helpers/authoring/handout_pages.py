@@ -1,9 +1,10 @@
 """How a handout page looks and reads: offline maths, described figures, accessible markup.
 
 :func:`handout_exporter` is the nbconvert ``HTMLExporter`` (lab template) that renders one
-notebook as a handout page; :func:`mathjax_files` lists the MathJax files the pages load,
-which the build copies once into the handouts folder (``mathjax/``), so the pages typeset
-their equations with no network and no third-party script.
+notebook as a handout page (with links to another notebook of the pack pointed at its
+page); :func:`mathjax_files` lists the MathJax files the pages load, which the build copies
+once into the handouts folder (``mathjax/``), so the pages typeset their equations with no
+network and no third-party script.
 
 Maths: MathJax 2.7 as shipped in the ``jupyter-server-mathjax`` wheel (the copy Jupyter's
 own tools serve), TeX input with the AMS extensions, SVG output. SVG output draws glyphs
@@ -28,6 +29,7 @@ their own box.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -35,6 +37,7 @@ import nbformat
 from jinja2 import DictLoader
 from nbconvert.exporters import HTMLExporter
 from nbconvert.preprocessors import Preprocessor
+from traitlets import List, Unicode
 from traitlets.config import Config
 
 #: Folder of the MathJax copy inside the handouts folder.
@@ -336,8 +339,37 @@ class _PageResources(Preprocessor):
         return nb, resources
 
 
+class NotebookLinkPreprocessor(Preprocessor):
+    """Point markdown links to another notebook of the pack at that notebook's page.
+
+    ``[see question (c)](03_fusion.ipynb#The-question)`` becomes a link to
+    ``03_fusion.html#The-question``, in markdown and in raw ``href`` attributes. Only
+    the notebooks named in ``stems`` are rewritten; any other link is left alone.
+    """
+
+    stems = List(Unicode(), help="File stems of the notebooks that have a page.").tag(
+        config=True)
+
+    _LINK = re.compile(
+        r"""(?P<before>\]\(\s*<?|href\s*=\s*["'])(?:\./)?(?P<stem>[\w.-]+)\.ipynb"""
+        r"""(?=[#)>"'\s])"""
+    )
+
+    def preprocess_cell(self, cell: nbformat.NotebookNode, resources: dict,
+                        index: int) -> tuple[nbformat.NotebookNode, dict]:
+        """Rewrite the links of a markdown cell."""
+        if cell.cell_type == "markdown" and ".ipynb" in cell.source:
+            stems = set(self.stems)
+            cell.source = self._LINK.sub(
+                lambda match: (f"{match['before']}{match['stem']}.html"
+                               if match["stem"] in stems else match[0]),
+                cell.source,
+            )
+        return cell, resources
+
+
 def handout_exporter(*, code: bool = True, mathjax_url: str = "",
-                     preprocessors: Sequence[Preprocessor] = ()) -> HTMLExporter:
+                     stems: Sequence[str] = ()) -> HTMLExporter:
     """The HTML exporter for handout pages.
 
     Parameters
@@ -349,8 +381,9 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = "",
         URL that loads MathJax (``async``) as the page sees it, configuration query
         included: :func:`mathjax_url` for the local copy; ``""`` (default) leaves
         MathJax out, and the equations show as their LaTeX source.
-    preprocessors : sequence of Preprocessor
-        Further preprocessors, run after nbconvert's own (e.g. link rewriting).
+    stems : sequence of str
+        File stems of the notebooks that get a page next to this one; markdown links
+        to ``<stem>.ipynb`` are pointed at ``<stem>.html`` (:class:`NotebookLinkPreprocessor`).
 
     Returns
     -------
@@ -377,8 +410,7 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = "",
                             extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
     exporter.template_file = _TEMPLATE_NAME
     exporter.register_preprocessor(_PageResources(), enabled=True)
-    for preprocessor in preprocessors:
-        exporter.register_preprocessor(preprocessor, enabled=True)
+    exporter.register_preprocessor(NotebookLinkPreprocessor(stems=list(stems)), enabled=True)
     return exporter
 
 

@@ -14,7 +14,7 @@ error output, or displays a widget with no static view (which a page could only 
 as a placeholder) stops the build, and the message names the notebook and the cell
 (and gives the traceback); output on stderr (a warning) is reported but kept. A cell
 may run ``--timeout`` seconds (default 300). Only once every page is ready is anything
-written, all together or not at all (:mod:`lqe_helpers.authoring.files`): the folder's
+written, all together or not at all (:mod:`lqe_helpers.authoring.output_folder`): the folder's
 manifest ``.lqe-manifest.json`` lists what the build wrote, so the next build replaces or
 deletes only those files (the page of a notebook since renamed goes) and only while they
 are unchanged. Any other file there (an instructor's ``course_home.html``) is never
@@ -36,37 +36,33 @@ Pages are rendered by nbconvert's ``HTMLExporter`` (lab template) with:
 
 from __future__ import annotations
 
-import argparse
-import copy
-import re
-import warnings
-from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
-from urllib.parse import quote
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
-from nbconvert.exporters import HTMLExporter
-from nbconvert.filters import strip_ansi
-from nbconvert.preprocessors import Preprocessor
-from traitlets import List, Unicode
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import copy
+    import warnings
+    from collections.abc import Sequence
+    from dataclasses import dataclass
+    from pathlib import Path
+    from urllib.parse import quote
 
-from lqe_helpers.authoring import handout_pages
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    ToolError,
-    plan_output_folder,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
-from lqe_helpers.authoring.notebook_runner import (
-    CELL_TIMEOUT,
-    WIDGET_VIEW_MIMETYPE,
-    NotebookRunError,
-    execute_notebook,
-    positive_seconds,
-)
+    import nbformat
+    from nbconvert.filters import strip_ansi
+
+    from lqe_helpers.authoring import handout_pages
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import ToolError, shown, summarise
+    from lqe_helpers.authoring.execution import (
+        CELL_TIMEOUT,
+        WIDGET_VIEW_MIMETYPE,
+        NotebookRunError,
+        execute_notebook,
+        positive_seconds,
+    )
+    from lqe_helpers.authoring.handout_pages import handout_exporter
+    from lqe_helpers.authoring.notebook_io import source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
 
 #: Folder (inside the output folder) of the variant without code cells.
 PROSE_DIR = "prose"
@@ -89,35 +85,6 @@ class HandoutBuildError(ToolError, RuntimeError):
 
 class HandoutWarning(UserWarning):
     """A handout page will show something a reader should not need (a warning)."""
-
-
-class NotebookLinkPreprocessor(Preprocessor):
-    """Point markdown links to another notebook of the pack at that notebook's page.
-
-    ``[see question (c)](03_fusion.ipynb#The-question)`` becomes a link to
-    ``03_fusion.html#The-question``, in markdown and in raw ``href`` attributes. Only
-    the notebooks named in ``stems`` are rewritten; any other link is left alone.
-    """
-
-    stems = List(Unicode(), help="File stems of the notebooks that have a page.").tag(
-        config=True)
-
-    _LINK = re.compile(
-        r"""(?P<before>\]\(\s*<?|href\s*=\s*["'])(?:\./)?(?P<stem>[\w.-]+)\.ipynb"""
-        r"""(?=[#)>"'\s])"""
-    )
-
-    def preprocess_cell(self, cell: nbformat.NotebookNode, resources: dict,
-                        index: int) -> tuple[nbformat.NotebookNode, dict]:
-        """Rewrite the links of a markdown cell."""
-        if cell.cell_type == "markdown" and ".ipynb" in cell.source:
-            stems = set(self.stems)
-            cell.source = self._LINK.sub(
-                lambda match: (f"{match['before']}{match['stem']}.html"
-                               if match["stem"] in stems else match[0]),
-                cell.source,
-            )
-        return cell, resources
 
 
 @dataclass(frozen=True)
@@ -202,27 +169,6 @@ def stderr_outputs(notebook: nbformat.NotebookNode) -> list[str]:
     ]
 
 
-def handout_exporter(*, code: bool = True, mathjax_url: str = "",
-                     stems: Sequence[str] = ()) -> HTMLExporter:
-    """The HTML exporter for handout pages (:func:`handout_pages.handout_exporter`).
-
-    Parameters
-    ----------
-    code : bool
-        Show the code cells' source (``False`` for the prose variant: markdown,
-        printed results and figures only, without prompts).
-    mathjax_url : str
-        URL that loads MathJax as the page sees it
-        (:func:`handout_pages.mathjax_url` for the local copy); ``""`` leaves it out.
-    stems : sequence of str
-        File stems of the notebooks that get a page next to this one; markdown links
-        to ``<stem>.ipynb`` are pointed at ``<stem>.html``.
-    """
-    return handout_pages.handout_exporter(
-        code=code, mathjax_url=mathjax_url,
-        preprocessors=[NotebookLinkPreprocessor(stems=list(stems))])
-
-
 def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNode:
     """A one-cell notebook whose markdown lists ``pages`` in order (the index page)."""
     if code:
@@ -249,11 +195,11 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
 def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode:
     """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
 
-    Every cell runs even after one raises, so the message can name each cell that
-    shows an error (the first is usually the cause; later ones may follow from it)
-    and give the first traceback. A cell past ``timeout`` seconds or a kernel that
-    dies stops the build too. Warns (:class:`HandoutWarning`) if a cell printed to
-    stderr.
+    Every cell runs even after one raises, so the message can name the cells that
+    show an error (the first few, and how many more: the first is usually the cause;
+    later ones may follow from it) and give the first traceback. A cell past
+    ``timeout`` seconds or a kernel that dies stops the build too. Warns
+    (:class:`HandoutWarning`) if a cell printed to stderr.
     """
     try:
         notebook = execute_notebook(path, timeout, allow_errors=True)
@@ -261,23 +207,25 @@ def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode
         raise HandoutBuildError(str(error)) from error
     errors = error_outputs(notebook)
     if errors:
-        raise HandoutBuildError(f"{path} shows error output(s): {'; '.join(errors)}\n"
+        raise HandoutBuildError(f"{path} shows error output(s): "
+                                f"{summarise(errors, separator='; ')}\n"
                                 f"Traceback of the first, {error_tracebacks(notebook)[0]}")
     widgets = unshowable_widgets(notebook)
     if widgets:
         raise HandoutBuildError(
             f"{path} displays widget(s) with no static view, which a page could only show "
-            f"as a placeholder (display an Explorer, or a figure): {'; '.join(widgets)}")
+            f"as a placeholder (display an Explorer, or a figure): "
+            f"{summarise(widgets, separator='; ')}")
     undescribed = handout_pages.undescribed_figures(notebook)
     if undescribed:
         warnings.warn(f"{path} shows figure(s) with no description, which its page can "
                       f"only give a generic alt text (show them with plotting.show_figure): "
-                      f"{'; '.join(undescribed)}",
+                      f"{summarise(undescribed, separator='; ')}",
                       HandoutWarning, stacklevel=3)
     printed = stderr_outputs(notebook)
     if printed:
         warnings.warn(f"{path} prints to stderr, which its page will show: "
-                      f"{'; '.join(printed)}", HandoutWarning, stacklevel=3)
+                      f"{summarise(printed, separator='; ')}", HandoutWarning, stacklevel=3)
     notebook.metadata.pop("widgets", None)
     return notebook
 
@@ -294,7 +242,7 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
 
     The output folder is checked before any notebook runs, and written only once every
-    page is ready, all together (:func:`~lqe_helpers.authoring.files.write_output_folder`):
+    page is ready, all together (:func:`~lqe_helpers.authoring.output_folder.build_output_folder`):
     any failure leaves it as it was. The build records what it wrote in the folder's
     manifest (``.lqe-manifest.json``); a rebuild replaces or deletes only those files,
     and only while they are unchanged. Every other file in the folder (an instructor's
@@ -340,13 +288,24 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
     paths = source_notebooks(source_dir)
     local = mathjax_url == LOCAL_MATHJAX
     mathjax = handout_pages.mathjax_copy() if local else {}
-    plan_output_folder(out_dir, [*_page_names([path.stem for path in paths]), *mathjax],
-                       tool=TOOL_NAME, source_dir=source_dir)
-    executed = [(path, _execute(path, timeout)) for path in paths]
-    pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
+    page_names = _page_names([path.stem for path in paths])
 
-    # Every file of the build, relative to out_dir; anything else the handouts need
-    # (a copy of MathJax, say) goes in here too, so the manifest covers it.
+    def pages() -> dict[str, str | bytes]:
+        files = _render_pages([(path, _execute(path, timeout)) for path in paths],
+                              mathjax_url=mathjax_url)
+        files.update(mathjax)  # listed in the manifest too
+        return files
+
+    written = build_output_folder(out_dir, [*page_names, *mathjax], pages, tool=TOOL_NAME,
+                                  sources=[source_dir])
+    return written[:len(page_names)]
+
+
+def _render_pages(executed: Sequence[tuple[Path, nbformat.NotebookNode]], *,
+                  mathjax_url: str) -> dict[str, str | bytes]:
+    """Every page of the build (with and without code, and the two index pages)."""
+    local = mathjax_url == LOCAL_MATHJAX
+    pages = [Page(path.stem, notebook_title(notebook, path.stem)) for path, notebook in executed]
     files: dict[str, str | bytes] = {}
     for code, folder in ((True, ""), (False, f"{PROSE_DIR}/")):
         page_mathjax = handout_pages.mathjax_url(folder.count("/")) if local else mathjax_url
@@ -367,10 +326,7 @@ def build_handouts(source_dir: Path, out_dir: Path, *,
         html, _ = exporter.from_notebook_node(
             _index_notebook(pages, code=code), {"metadata": {"name": "index"}})
         files[folder + "index.html"] = html
-    pages_written = len(files)
-    files.update(mathjax)
-    return write_output_folder(out_dir, files, tool=TOOL_NAME,
-                               source_dir=source_dir)[:pages_written]
+    return files
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -393,7 +349,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def command(args: argparse.Namespace) -> int:
         for path in build_handouts(args.source, args.out, mathjax_url=args.mathjax_url,
                                    timeout=args.timeout):
-            print(path)
+            print(shown(path))
         return 0
 
     return run_command(parser, command, argv)

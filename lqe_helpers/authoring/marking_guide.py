@@ -18,36 +18,38 @@ writes one Markdown file, ``marking-guide.md``. For each notebook, in order:
 
 Nothing is executed: the notebooks' saved outputs are read (nbval proves they are what
 a fresh run prints). The source notebooks are only read. The file is written through
-:mod:`lqe_helpers.authoring.files` (atomically, into a folder the tool owns).
+:mod:`lqe_helpers.authoring.output_folder` (atomically, into a folder the tool owns).
 """
 
 from __future__ import annotations
 
-import argparse
-import inspect
-import re
-from collections.abc import Sequence
-from dataclasses import dataclass
-from pathlib import Path
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import inspect
+    import re
+    from collections.abc import Sequence
+    from dataclasses import dataclass
+    from pathlib import Path
 
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    read_notebook,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
-from lqe_helpers.authoring.student_edition import (
-    ANSWER_TAG,
-    CHECK_CALL,
-    GOING_FURTHER,
-    SOLUTION_TAG,
-    answer_headings,
-    cell_place,
-    task_instruction,
-)
+    import nbformat
+
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
+    from lqe_helpers.authoring.task_cells import (
+        ANSWER_TAG,
+        CHECK_CALL,
+        GOING_FURTHER,
+        SOLUTION_TAG,
+        answer_headings,
+        cell_place,
+        cell_tags,
+        check_cell_tags,
+        task_instruction,
+    )
 
 #: Name of the tool in the output folder's manifest.
 TOOL_NAME = "marking_guide"
@@ -225,18 +227,15 @@ def output_blocks(cell: nbformat.NotebookNode, where: str) -> list[str]:
     return blocks
 
 
-def _tags(cell: nbformat.NotebookNode) -> list[str]:
-    return list(cell.get("metadata", {}).get("tags", []))
-
-
 def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     """What the guide says about one worked notebook (see the module docstring).
 
     Raises
     ------
     ValueError
-        If the notebook was never executed (no expected values), a cell saved an
-        error, a check cell calls an unknown check, or its marks are wrong.
+        If the notebook was never executed (no expected values), a cell breaks the tag
+        convention (a misspelt ``solution`` tag would drop its task from the guide), a
+        cell saved an error, a check cell calls an unknown check, or its marks are wrong.
     """
     question, marks = question_and_marks(notebook, name)
     cells = notebook.cells
@@ -246,8 +245,9 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
     items: list[Task | Answer] = []
     core = True
     for index, cell in enumerate(cells):
-        tags = _tags(cell)
+        tags = cell_tags(cell)
         where = cell_place(name, index, cell)
+        check_cell_tags(cell, where)  # a misspelt tag would drop a task from the guide
         if cell.cell_type == "markdown" and cell.source.lstrip().startswith(GOING_FURTHER):
             core = False
         if SOLUTION_TAG in tags:
@@ -255,7 +255,7 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
                                    for line in task_instruction(cell.source))
             after = cells[index + 1] if index + 1 < len(cells) else None
             check = (after.source.strip() if after is not None and after.cell_type == "code"
-                     and CHECK_CALL in after.source and not _tags(after) else None)
+                     and CHECK_CALL in after.source and not cell_tags(after) else None)
             printed = "".join(output.get("text", "") for output in after.get("outputs", [])
                               ).strip() if check else ""
             items.append(Task(where, instruction, core, check,
@@ -344,7 +344,7 @@ def build_marking_guide(source_dir: Path, out_dir: Path) -> Path:
         Folder of the worked, executed notebooks (read only).
     out_dir : Path
         Folder for the guide (created if needed; the tool replaces only what it wrote
-        there, see :func:`lqe_helpers.authoring.files.write_output_folder`).
+        there, see :func:`lqe_helpers.authoring.output_folder.build_output_folder`).
 
     Returns
     -------
@@ -358,10 +358,14 @@ def build_marking_guide(source_dir: Path, out_dir: Path) -> Path:
         are (the message says which).
     """
     source_dir = Path(source_dir)
-    guides = [notebook_guide(read_notebook(path), path.name)
-              for path in source_notebooks(source_dir)]
-    [written] = write_output_folder(out_dir, {GUIDE_NAME: render(guides, source_dir.as_posix())},
-                                    tool=TOOL_NAME, source_dir=source_dir)
+    paths = source_notebooks(source_dir)
+
+    def guide() -> dict[str, str]:
+        guides = [notebook_guide(read_notebook(path), path.name) for path in paths]
+        return {GUIDE_NAME: render(guides, source_dir.as_posix())}
+
+    [written] = build_output_folder(out_dir, [GUIDE_NAME], guide, tool=TOOL_NAME,
+                                    sources=[source_dir])
     return written
 
 
@@ -375,7 +379,7 @@ def main(argv: Sequence[str] | None = None) -> int:
                         help="folder for marking-guide.md (default: build/marking-guide)")
 
     def command(args: argparse.Namespace) -> int:
-        print(build_marking_guide(args.source, args.out))
+        print(shown(build_marking_guide(args.source, args.out)))
         return 0
 
     return run_command(parser, command, argv)

@@ -33,7 +33,7 @@ kernel, the language and the pack's own ``lqe`` entry (question, marks, core min
 is dropped (widget state included). The source notebooks are
 only read, never written. The output folder must not be, contain or lie inside the
 source folder. It is written all together or not at all, and its manifest
-``.lqe-manifest.json`` lists what the build wrote (:mod:`lqe_helpers.authoring.files`): a
+``.lqe-manifest.json`` lists what the build wrote (:mod:`lqe_helpers.authoring.output_folder`): a
 rebuild replaces or deletes only those files (the edition of a notebook since renamed
 goes), and only while they are unchanged. Any other file there (an instructor's
 ``my_grading_notes.ipynb``, a hand-edited copy, a symbolic link) is never touched; one in
@@ -46,84 +46,109 @@ builds it anyway, with a warning.
 
 from __future__ import annotations
 
-import argparse
-import ast
-import copy
-import difflib
-import io
-import re
-import tokenize
-import warnings
-from collections.abc import Sequence
-from pathlib import Path
-from typing import Any
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-import nbformat
-from nbconvert.exporters import NotebookExporter
-from nbconvert.preprocessors import (
-    ClearMetadataPreprocessor,
-    ClearOutputPreprocessor,
-    Preprocessor,
-)
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import copy
+    import warnings
+    from collections.abc import Sequence
+    from pathlib import Path
+    from typing import Any
 
-# MANIFEST_NAME and the Output*Error classes are re-exported: where the build records
-# what it wrote, and what build_student_edition raises.
-from lqe_helpers.authoring.files import (
-    MANIFEST_NAME as MANIFEST_NAME,
-)
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    check_out_dir,
-    read_notebook,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
-from lqe_helpers.authoring.files import (
-    OutputFolderError as OutputFolderError,
-)
-from lqe_helpers.authoring.files import (
-    OutputWriteError as OutputWriteError,
-)
+    import nbformat
+    from nbconvert.exporters import NotebookExporter
+    from nbconvert.preprocessors import (
+        ClearMetadataPreprocessor,
+        ClearOutputPreprocessor,
+        Preprocessor,
+    )
+
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+
+    # MANIFEST_NAME and the Output*Error classes are re-exported: where the build records
+    # what it wrote, and what build_student_edition raises.
+    from lqe_helpers.authoring.errors import OutputFolderError as OutputFolderError
+    from lqe_helpers.authoring.errors import OutputWriteError as OutputWriteError
+    from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.manifest import MANIFEST_NAME as MANIFEST_NAME
+    from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
+
+    # The cell convention is part of the student edition's interface: re-exported here.
+    from lqe_helpers.authoring.task_cells import (
+        ALLOWED_TAGS,
+        ANSWER_PROMPT,
+        ANSWER_PROMPT_TAG,
+        ANSWER_TAG,
+        CHECK_CALL,
+        EXPLORER_TAG,
+        GOING_FURTHER,
+        IGNORE_OUTPUT_TAG,
+        SOLUTION_TAG,
+        STUB_MESSAGE,
+        TASK_LIKE,
+        TASK_PREFIX,
+        TASK_TAG,
+        answer_headings,
+        cell_place,
+        cell_tags,
+        check_cell_tags,
+        function_stub,
+        prompt_source,
+        stub_source,
+        task_instruction,
+    )
+
+__all__ = [
+    "ALLOWED_TAGS",
+    "ANSWER_PROMPT",
+    "ANSWER_PROMPT_TAG",
+    "ANSWER_TAG",
+    "CHECK_CALL",
+    "EXPLORER_TAG",
+    "GOING_FURTHER",
+    "IGNORE_OUTPUT_TAG",
+    "MANIFEST_NAME",
+    "NOTE_TAG",
+    "SOLUTION_TAG",
+    "STUB_MESSAGE",
+    "STUDENT_NOTE",
+    "STUDENT_TAGS",
+    "TASK_LIKE",
+    "TASK_PREFIX",
+    "TASK_TAG",
+    "TOOL_NAME",
+    "MissingSolutionsError",
+    "MissingSolutionsWarning",
+    "OutputFolderError",
+    "OutputWriteError",
+    "StudentEditionPreprocessor",
+    "answer_headings",
+    "build_student_edition",
+    "cell_place",
+    "cell_tags",
+    "check_cell_tags",
+    "check_has_solutions",
+    "count_solutions",
+    "function_stub",
+    "main",
+    "prompt_source",
+    "stub_source",
+    "student_edition",
+    "student_exporter",
+    "task_instruction",
+]
 
 #: Name the student edition records in its output folder's manifest.
 TOOL_NAME = "student_edition"
 
-#: Tag of a code cell holding a worked solution (source notebooks).
-SOLUTION_TAG = "solution"
-#: Tag of a markdown cell holding a written answer (source notebooks).
-ANSWER_TAG = "answer"
-#: Tag of a code cell showing an interactive explorer (kept in the student edition).
-EXPLORER_TAG = "explorer"
-#: nbval's tag for a cell whose output is not compared (every explorer carries it).
-IGNORE_OUTPUT_TAG = "nbval-ignore-output"
-#: The only tags a source notebook may carry; any other is an error in the build.
-ALLOWED_TAGS = frozenset({SOLUTION_TAG, ANSWER_TAG, EXPLORER_TAG, IGNORE_OUTPUT_TAG})
-#: Tag of the stub that replaces a solution cell (student edition).
-TASK_TAG = "task"
-#: Tag of the prompt that replaces an answer cell (student edition).
-ANSWER_PROMPT_TAG = "answer-prompt"
 #: Tag of the note on how to use the student edition, inserted after the title cell.
 NOTE_TAG = "student-note"
 #: The tags a student notebook carries (what the student pack's tests allow).
 STUDENT_TAGS = frozenset({TASK_TAG, ANSWER_PROMPT_TAG, NOTE_TAG, EXPLORER_TAG,
                           IGNORE_OUTPUT_TAG})
 
-#: How the instruction at the top of a solution cell starts.
-TASK_PREFIX = "# Task:"
-#: A first line that looks like a task instruction, however it is spelt or spaced.
-TASK_LIKE = re.compile(r"#\s*task\s*:", re.IGNORECASE)
-#: The heading that ends the core path of a notebook (what follows is optional).
-GOING_FURTHER = "## Going further"
-#: How the call in the check cell after a core task starts.
-CHECK_CALL = "checks.check_"
-#: What a stub raises.
-STUB_MESSAGE = "Replace this line with your code for the task described above."
-#: What an answer cell becomes.
-ANSWER_PROMPT = (
-    "**Your answer:** *Replace this line with your answer, backed by the numbers "
-    "and figures your code produced.*"
-)
 #: Markdown inserted after the first cell of every student notebook.
 STUDENT_NOTE = (
     "> **Student edition.** Cells starting with `# Task:` are yours to write: replace "
@@ -140,211 +165,6 @@ class MissingSolutionsError(ValueError):
 
 class MissingSolutionsWarning(UserWarning):
     """A student notebook was built from a source with no ``solution`` cell."""
-
-
-def task_instruction(source: str) -> list[str]:
-    """The instruction lines at the top of a solution cell.
-
-    Parameters
-    ----------
-    source : str
-        The cell's source code.
-
-    Returns
-    -------
-    list of str
-        The leading block of comment lines (up to the first line that is not a
-        comment), the first of which starts with ``# Task:``.
-
-    Raises
-    ------
-    ValueError
-        If the cell does not start with a ``# Task:`` line.
-    """
-    lines = source.splitlines()
-    if not lines or not lines[0].startswith(TASK_PREFIX):
-        first = lines[0] if lines else ""
-        raise ValueError(
-            f"a solution cell must start with a '{TASK_PREFIX} ...' comment line, "
-            f"got {first!r}"
-        )
-    block = []
-    for line in lines:
-        if not line.lstrip().startswith("#"):
-            break
-        block.append(line.rstrip())
-    return block
-
-
-def _header_end(lines: list[str], node: ast.FunctionDef | ast.AsyncFunctionDef) -> tuple[int, int]:
-    """Line (1-based) and column just after the ``:`` that ends a ``def`` header."""
-    text = "\n".join(lines[node.lineno - 1:]) + "\n"
-    depth, started = 0, False
-    for token in tokenize.generate_tokens(io.StringIO(text).readline):
-        if not started:
-            started = token.type == tokenize.NAME and token.string == "def"
-        elif token.type == tokenize.OP and token.string in "([{":
-            depth += 1
-        elif token.type == tokenize.OP and token.string in ")]}":
-            depth -= 1
-        elif token.type == tokenize.OP and token.string == ":" and depth == 0:
-            return node.lineno + token.end[0] - 1, token.end[1]
-    raise ValueError(f"no ':' ends the header of def {node.name}")  # unreachable for valid code
-
-
-def function_stub(lines: list[str], node: ast.FunctionDef | ast.AsyncFunctionDef) -> list[str]:
-    """A top-level function with its body replaced by ``raise NotImplementedError(...)``.
-
-    Parameters
-    ----------
-    lines : list of str
-        The lines of the code the function was parsed from.
-    node : ast.FunctionDef or ast.AsyncFunctionDef
-        The function.
-
-    Returns
-    -------
-    list of str
-        Its decorators and signature exactly as written, its docstring (if it has one),
-        then the raise. Comments and code of the body are dropped.
-    """
-    start = min([node.lineno, *(decorator.lineno for decorator in node.decorator_list)])
-    end_line, end_column = _header_end(lines, node)
-    stub = [*lines[start - 1:end_line - 1], lines[end_line - 1][:end_column]]
-    first = node.body[0]
-    on_own_line = first.lineno > end_line
-    indent = " " * (first.col_offset if on_own_line else node.col_offset + 4)
-    if ast.get_docstring(node, clean=False) is not None:  # as written, nothing after it
-        stub.append(indent + ast.get_source_segment("\n".join(lines), first))
-    stub.append(f'{indent}raise NotImplementedError("{STUB_MESSAGE}")')
-    return stub
-
-
-def stub_source(source: str) -> str:
-    """The student-edition stub for a solution cell.
-
-    Parameters
-    ----------
-    source : str
-        The solution cell's source: a ``# Task:`` comment block, then the worked code.
-
-    Returns
-    -------
-    str
-        The comment block; then each top-level function's signature (and docstring)
-        with its body replaced by ``raise NotImplementedError(...)``; then, if the cell
-        holds any other code (or cannot be parsed), one ``raise NotImplementedError(...)``
-        line in its place. So a cell that only defines functions runs (the check after
-        it reports them "not written yet"); any other stub stops Run All at itself.
-
-    Raises
-    ------
-    ValueError
-        If the cell does not start with a ``# Task:`` line.
-    """
-    instruction = task_instruction(source)
-    lines = source.splitlines()[len(instruction):]
-    try:
-        body = ast.parse("\n".join(lines)).body
-    except SyntaxError:  # IPython syntax (magics) or a broken cell: stub it whole
-        body = [ast.Pass()]
-    parts = [function_stub(lines, node) for node in body
-             if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef)]
-    if len(parts) < len(body) or not parts:
-        parts.append([f'raise NotImplementedError("{STUB_MESSAGE}")'])
-    blocks = ["\n".join(part) for part in parts]
-    return "\n".join(instruction) + "\n" + "\n\n\n".join(blocks)
-
-
-def answer_headings(source: str) -> list[str]:
-    """The markdown headings at the top of an answer cell (kept in its prompt).
-
-    Parameters
-    ----------
-    source : str
-        The answer cell's markdown.
-
-    Returns
-    -------
-    list of str
-        The heading lines (``#`` ...) before the first line of other text; blank
-        lines between them are skipped.
-    """
-    headings = []
-    for line in source.splitlines():
-        if line.startswith("#"):
-            headings.append(line.rstrip())
-        elif line.strip():
-            break
-    return headings
-
-
-def prompt_source(source: str) -> str:
-    """The student-edition prompt for an answer cell: its headings, then the prompt."""
-    return "\n\n".join([*answer_headings(source), ANSWER_PROMPT])
-
-
-def _tags(cell: nbformat.NotebookNode) -> list[str]:
-    return list(cell.get("metadata", {}).get("tags", []))
-
-
-def cell_place(name: str, index: int, cell: nbformat.NotebookNode) -> str:
-    """Where a cell is, for messages: notebook, cell index and the cell's first line."""
-    lines = cell.source.strip().splitlines()
-    first = lines[0] if lines else ""
-    return f"{name}, cell {index} ({first[:60]!r})"
-
-
-def check_cell_tags(cell: nbformat.NotebookNode, where: str) -> None:
-    """Refuse a cell that breaks the tag convention of the source notebooks.
-
-    Parameters
-    ----------
-    cell : nbformat.NotebookNode
-        A cell of a source notebook.
-    where : str
-        The cell's place (:func:`cell_place`), put at the start of the message.
-
-    Raises
-    ------
-    ValueError
-        If the cell carries a tag outside :data:`ALLOWED_TAGS` (the message suggests
-        the nearest allowed one), a tag on the wrong kind of cell, ``solution`` and
-        ``answer`` together, an explorer also marked as a solution or an answer or
-        without ``nbval-ignore-output``, or if it is a code cell that starts like a
-        task (``# Task:``) without the ``solution`` tag.
-    """
-    tags = _tags(cell)
-    for tag in tags:
-        if tag not in ALLOWED_TAGS:
-            near = difflib.get_close_matches(tag.lower(), sorted(ALLOWED_TAGS), n=1, cutoff=0.6)
-            hint = f" (did you mean {near[0]!r}?)" if near else ""
-            raise ValueError(f"{where}: unknown tag {tag!r}{hint}; the allowed tags are "
-                             f"{', '.join(sorted(ALLOWED_TAGS))}")
-    is_solution, is_answer = SOLUTION_TAG in tags, ANSWER_TAG in tags
-    if is_solution and is_answer:
-        raise ValueError(f"{where}: a cell cannot be tagged both {SOLUTION_TAG!r} and "
-                         f"{ANSWER_TAG!r}")
-    if EXPLORER_TAG in tags:
-        if is_solution or is_answer:
-            raise ValueError(f"{where}: an {EXPLORER_TAG!r} cell must not also be tagged "
-                             f"{SOLUTION_TAG if is_solution else ANSWER_TAG!r}")
-        if cell.cell_type != "code":
-            raise ValueError(f"{where}: tag {EXPLORER_TAG!r} is for code cells, got a "
-                             f"{cell.cell_type} cell")
-        if IGNORE_OUTPUT_TAG not in tags:
-            raise ValueError(f"{where}: an {EXPLORER_TAG!r} cell must also be tagged "
-                             f"{IGNORE_OUTPUT_TAG!r} (its widget output differs run to run)")
-    if is_solution and cell.cell_type != "code":
-        raise ValueError(f"{where}: tag {SOLUTION_TAG!r} is for code cells, got a "
-                         f"{cell.cell_type} cell")
-    if is_answer and cell.cell_type != "markdown":
-        raise ValueError(f"{where}: tag {ANSWER_TAG!r} is for markdown cells, got a "
-                         f"{cell.cell_type} cell")
-    if (cell.cell_type == "code" and not is_solution
-            and TASK_LIKE.match(cell.source.lstrip())):
-        raise ValueError(f"{where}: starts like a task but is not tagged {SOLUTION_TAG!r}, "
-                         f"so its worked code would be handed out; tag it {SOLUTION_TAG!r}")
 
 
 class StudentEditionPreprocessor(Preprocessor):
@@ -379,7 +199,7 @@ class StudentEditionPreprocessor(Preprocessor):
         """Check the cell's tags; stub a solution, turn an answer into a prompt."""
         where = cell_place(resources.get("metadata", {}).get("name", "notebook"), index, cell)
         check_cell_tags(cell, where)
-        tags = _tags(cell)
+        tags = cell_tags(cell)
         if SOLUTION_TAG in tags:
             try:
                 cell.source = stub_source(cell.source)
@@ -414,7 +234,7 @@ def student_exporter() -> NotebookExporter:
 
 def count_solutions(notebook: nbformat.NotebookNode) -> int:
     """How many cells of ``notebook`` are tagged ``solution``."""
-    return sum(SOLUTION_TAG in _tags(cell) for cell in notebook.cells)
+    return sum(SOLUTION_TAG in cell_tags(cell) for cell in notebook.cells)
 
 
 def check_has_solutions(notebook: nbformat.NotebookNode, name: str, *,
@@ -435,9 +255,14 @@ def check_has_solutions(notebook: nbformat.NotebookNode, name: str, *,
 
     Raises
     ------
+    ValueError
+        If a cell breaks the tag convention (:func:`check_cell_tags`), checked first: a
+        misspelt ``solution`` tag is named as such, not reported as a missing one.
     MissingSolutionsError
         If no cell is tagged ``solution`` and ``allow_without_solutions`` is false.
     """
+    for index, cell in enumerate(notebook.cells):
+        check_cell_tags(cell, cell_place(name.removesuffix(".ipynb"), index, cell))
     if count_solutions(notebook):
         return
     if not allow_without_solutions:
@@ -481,7 +306,7 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
     """Write the student edition of every notebook in ``source_dir`` to ``out_dir``.
 
     Every notebook is read and transformed before anything is written, and the files
-    are written together (:func:`~lqe_helpers.authoring.files.write_output_folder`), so
+    are written together (:func:`~lqe_helpers.authoring.output_folder.build_output_folder`), so
     a refused or failed build leaves ``out_dir`` as it was. The folder's manifest
     (``.lqe-manifest.json``) lists what the build wrote; a rebuild replaces or deletes
     only those files, and only while unchanged (an edition of a notebook since renamed
@@ -518,14 +343,18 @@ def build_student_edition(source_dir: Path, out_dir: Path, *,
     """
     source_dir, out_dir = Path(source_dir), Path(out_dir)
     paths = source_notebooks(source_dir)
-    check_out_dir(source_dir, out_dir)
-    editions: dict[str, str] = {}
-    for path in paths:
-        notebook = read_notebook(path)
-        check_has_solutions(notebook, path.name,
-                            allow_without_solutions=allow_without_solutions)
-        editions[path.name] = student_edition(notebook, path.stem)
-    return write_output_folder(out_dir, editions, tool=TOOL_NAME, source_dir=source_dir)
+
+    def editions() -> dict[str, str]:
+        built = {}
+        for path in paths:
+            notebook = read_notebook(path)
+            check_has_solutions(notebook, path.name,
+                                allow_without_solutions=allow_without_solutions)
+            built[path.name] = student_edition(notebook, path.stem)
+        return built
+
+    return build_output_folder(out_dir, [path.name for path in paths], editions,
+                               tool=TOOL_NAME, sources=[source_dir])
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -544,7 +373,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     def command(args: argparse.Namespace) -> int:
         for path in build_student_edition(
                 args.source, args.out, allow_without_solutions=args.allow_without_solutions):
-            print(path)
+            print(shown(path))
         return 0
 
     return run_command(parser, command, argv)

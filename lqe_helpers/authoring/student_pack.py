@@ -26,27 +26,27 @@
 
 The marking guide is never in the pack. The zip is the same, byte for byte, for the same
 sources (fixed file times and order), and is written atomically into a folder the tool
-owns (:func:`lqe_helpers.authoring.files.write_output_folder`).
+owns (:func:`lqe_helpers.authoring.output_folder.write_output_folder`).
 """
 
 from __future__ import annotations
 
-import argparse
-import io
-import json
-import re
-import zipfile
-from collections.abc import Sequence
-from pathlib import Path
+from lqe_helpers.authoring.command_line import interrupt_exits_quietly
 
-from lqe_helpers.authoring import student_edition as se
-from lqe_helpers.authoring.files import (
-    CommandLineParser,
-    read_notebook,
-    run_command,
-    source_notebooks,
-    write_output_folder,
-)
+with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
+    import argparse
+    import io
+    import json
+    import re
+    import zipfile
+    from collections.abc import Sequence
+    from pathlib import Path
+
+    from lqe_helpers.authoring import student_edition as se
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
+    from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.output_folder import build_output_folder
 
 #: Name of the tool in the output folder's manifest.
 TOOL_NAME = "student_pack"
@@ -58,6 +58,8 @@ ZIP_NAME = f"{PACK_NAME}.zip"
 MARKER_NAME = "STUDENT-PACK.md"
 #: Files copied from the top of the course folder as they are (the README gets a note).
 TOP_FILES = ("README.md", "pyproject.toml", "constraints.txt")
+#: Folders of the course folder the pack copies from; its output folder may not overlap them.
+SOURCES = ("notebooks", "lqe_helpers", "tests")
 #: Sub-packages of lqe_helpers that stay with the instructor.
 INSTRUCTOR_PACKAGES = ("authoring",)
 #: Tests (files or folders under tests/) of the instructor's side, left out of the pack.
@@ -68,7 +70,7 @@ INSTRUCTOR_TESTS = ("browser", "test_notebook_files.py", "test_student_edition.p
                     "reference_loops.py", "test_reference.py", "test_checks_background.py",
                     "test_checks_vision.py", "test_checks_initial_covariance.py",
                     "test_checks_fusion.py", "test_checks_numbers.py", "test_checks_delay.py",
-                    "test_checks_bias.py")
+                    "test_checks_bias.py", "test_checks_noisier_proprioception.py")
 #: A test that mentions these needs what the pack leaves out (authoring, worked notebooks).
 INSTRUCTOR_ONLY = re.compile(r"lqe_helpers\.authoring|from lqe_helpers import authoring"
                              r"|[\"']notebooks[\"']")
@@ -150,10 +152,57 @@ def is_instructor_test(relative: Path, text: str | None) -> bool:
     return text is not None and bool(INSTRUCTOR_ONLY.search(text))
 
 
+def source_folders(root: Path) -> list[Path]:
+    """The folders of the course folder ``root`` that the pack copies from (:data:`SOURCES`)."""
+    return [Path(root) / name for name in SOURCES]
+
+
+def _refuse_link(path: Path) -> None:
+    if path.is_symlink():
+        raise ValueError(f"{shown(path)} is a symbolic link; the student pack copies only real "
+                         f"files (a link could bring in any file, the marking guide say): "
+                         f"put the file itself there, or remove the link")
+
+
 def _files_under(folder: Path) -> list[Path]:
-    return sorted(path for path in folder.rglob("*")
-                  if path.is_file() and "__pycache__" not in path.parts
-                  and path.suffix not in {".pyc", ".pyo"})
+    """Every regular file under ``folder``, sorted; ``__pycache__``, ``.pyc`` and ``.pyo`` left out.
+
+    Raises
+    ------
+    ValueError
+        Naming the first symbolic link, or the first entry that is neither a file nor a
+        folder (a fifo, a device, a socket), found in ``folder``.
+    """
+    _refuse_link(folder)
+    found = []
+    for path in sorted(folder.rglob("*")):
+        if "__pycache__" in path.relative_to(folder).parts:
+            continue
+        _refuse_link(path)
+        if path.is_dir():
+            continue
+        if not path.is_file():
+            raise ValueError(f"{shown(path)} is neither a file nor a folder (a fifo, device "
+                             f"or socket); the student pack copies only files: remove it")
+        if path.suffix not in {".pyc", ".pyo"}:
+            found.append(path)
+    return found
+
+
+def _read_text(path: Path) -> str:
+    """The UTF-8 text of the file ``path`` (not a link); a failure names the file."""
+    _refuse_link(path)
+    data = path.read_bytes()
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise ValueError(f"{shown(path)} is not UTF-8 text ({error.reason} at byte "
+                         f"{error.start}); save it as UTF-8") from None
+
+
+def _read_bytes(path: Path) -> bytes:
+    _refuse_link(path)
+    return path.read_bytes()
 
 
 def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[str, bytes]:
@@ -177,7 +226,9 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     ------
     ValueError
         If a needed file is missing, a notebook breaks the tag convention or has no
-        solution cell, or the Makefile lacks a rule the pack keeps.
+        solution cell, the Makefile lacks a rule the pack keeps, a file to copy is a
+        symbolic link or not a regular file, or a text file is not UTF-8 (the message
+        names the file).
     """
     root = Path(root)
     for needed in ("Makefile", *TOP_FILES, "lqe_helpers/__init__.py", "tests"):
@@ -198,7 +249,7 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     left_out = []
     for path in _files_under(root / "tests"):
         relative = path.relative_to(root / "tests")
-        text = path.read_text("utf-8") if path.suffix == ".py" else None
+        text = _read_text(path) if path.suffix == ".py" else None
         if is_instructor_test(relative, text):
             left_out.append(relative.parts[0])
         else:
@@ -211,12 +262,12 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
         "checked_notebooks": [name for name in names if name.startswith(CHECKED_PREFIXES)],
     }
     files[f"tests/{CONVENTIONS_NAME}"] = (json.dumps(conventions, indent=1) + "\n").encode()
-    files["Makefile"] = pack_makefile((root / "Makefile").read_text("utf-8")).encode()
-    readme = (root / "README.md").read_text("utf-8")
+    files["Makefile"] = pack_makefile(_read_text(root / "Makefile")).encode()
+    readme = _read_text(root / "README.md")
     title, _, rest = readme.partition("\n\n")
     files["README.md"] = f"{title}\n\n{README_NOTE}{rest}".encode()
     for name in TOP_FILES[1:]:
-        files[name] = (root / name).read_bytes()
+        files[name] = _read_bytes(root / name)
     files[MARKER_NAME] = marker_text(sorted(set(left_out))).encode()
     return dict(sorted(files.items()))
 
@@ -267,7 +318,8 @@ def build_student_pack(root: Path, out_dir: Path, *,
         The course folder (only read).
     out_dir : Path
         Folder for the zip (created if needed). The tool replaces only what it wrote
-        there, atomically; it must not be, contain or lie inside ``root/notebooks``.
+        there, atomically; it must not be, contain or lie inside a folder the pack
+        copies from (:data:`SOURCES`).
     allow_without_solutions : bool
         See :func:`pack_contents`.
 
@@ -279,13 +331,17 @@ def build_student_pack(root: Path, out_dir: Path, *,
     Raises
     ------
     ValueError
-        See :func:`pack_contents`; and :class:`~lqe_helpers.authoring.files.OutputFolderError`
+        See :func:`pack_contents`; and :class:`~lqe_helpers.authoring.errors.OutputFolderError`
         if ``out_dir`` cannot be used.
     """
     root = Path(root)
-    data = zip_bytes(pack_contents(root, allow_without_solutions=allow_without_solutions))
-    [written] = write_output_folder(out_dir, {ZIP_NAME: data}, tool=TOOL_NAME,
-                                    source_dir=root / "notebooks")
+
+    def pack() -> dict[str, bytes]:
+        contents = pack_contents(root, allow_without_solutions=allow_without_solutions)
+        return {ZIP_NAME: zip_bytes(contents)}
+
+    [written] = build_output_folder(out_dir, [ZIP_NAME], pack, tool=TOOL_NAME,
+                                    sources=source_folders(root))
     return written
 
 
@@ -302,8 +358,8 @@ def main(argv: Sequence[str] | None = None) -> int:
                              "instead of refusing")
 
     def command(args: argparse.Namespace) -> int:
-        print(build_student_pack(args.root, args.out,
-                                 allow_without_solutions=args.allow_without_solutions))
+        print(shown(build_student_pack(args.root, args.out,
+                                 allow_without_solutions=args.allow_without_solutions)))
         return 0
 
     return run_command(parser, command, argv)

@@ -16,9 +16,10 @@ the student's value with :func:`judging.judge` against a catalogue of likely mis
 One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
 every ``check_…`` and the tolerances:
 
-- ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02, with ``initial_covariance_further``), ``fusion`` (03), ``noisier_proprioception``
-  (04), ``delay`` (05), ``bias`` (06);
+- ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
+  ``vision_further`` for its Going further), ``initial_covariance`` (02, with
+  ``initial_covariance_further``), ``fusion`` (03, with ``fusion_further``),
+  ``noisier_proprioception`` (04, with ``misjudged_noise``), ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -29,7 +30,16 @@ every ``check_…`` and the tolerances:
 from .background import check_covariance_step, check_transition_matrix
 from .bias import check_bias_model
 from .delay import check_compensation, check_delay_difference, check_delay_mse
-from .fusion import check_fusion
+from .fusion import check_fusion, check_fusion_difference, check_fusion_trial
+from .fusion_further import (
+    THEORY_RTOL,
+    check_equivalent_sensor,
+    check_gain_shares,
+    check_halving,
+    check_noise_free_fits,
+    check_settled_filter,
+    check_settled_variances,
+)
 from .initial_covariance import (
     check_convergence_times,
     check_initial_covariance,
@@ -54,8 +64,23 @@ from .machinery import (
     TIME_ATOL,
     CheckFailed,
 )
+from .misjudged_noise import check_assumed_sweep, check_misjudged, check_misjudged_nis
+from .noisier_proprioception import (
+    check_noisier_difference,
+    check_noisier_theory,
+    check_noisier_trial,
+    check_proprioception_sweep,
+    check_sweep_reading,
+)
 from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
+from .vision_further import (
+    check_nis,
+    check_sampling_ratio,
+    check_steady_state,
+    check_systematic_error,
+)
+from .vision_smoothers import check_smoother, check_smoother_comparison
 
 __all__ = [
     "BOOTSTRAP_ATOL",
@@ -64,8 +89,10 @@ __all__ = [
     "MATRIX_RTOL",
     "MSE_RTOL",
     "SEED",
+    "THEORY_RTOL",
     "TIME_ATOL",
     "CheckFailed",
+    "check_assumed_sweep",
     "check_bias_model",
     "check_compensation",
     "check_convergence_intervals",
@@ -73,18 +100,39 @@ __all__ = [
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
+    "check_equivalent_sensor",
     "check_filter",
     "check_first_gains",
     "check_flight_scales",
     "check_fusion",
+    "check_fusion_difference",
+    "check_fusion_trial",
+    "check_gain_shares",
+    "check_halving",
     "check_initial_covariance",
     "check_initial_covariances",
+    "check_misjudged",
+    "check_misjudged_nis",
     "check_mse",
+    "check_nis",
+    "check_noise_free_fits",
+    "check_noisier_difference",
+    "check_noisier_theory",
+    "check_noisier_trial",
     "check_overconfidence",
     "check_p0_sweep",
     "check_paired_difference",
+    "check_proprioception_sweep",
+    "check_sampling_ratio",
+    "check_settled_filter",
+    "check_settled_variances",
+    "check_smoother",
+    "check_smoother_comparison",
     "check_start_and_after",
     "check_start_of_trial",
+    "check_steady_state",
+    "check_sweep_reading",
+    "check_systematic_error",
     "check_transition_matrix",
     "check_vision_difference",
     "check_vision_mse",

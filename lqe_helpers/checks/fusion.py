@@ -1,12 +1,40 @@
-"""Checks of notebook 03, question (c): C and R for vision and proprioception."""
+"""Checks of notebook 03, question (c): vision fused with proprioception.
+
+- :func:`check_fusion` (Task 1): C and R for the two senses;
+- :func:`check_fusion_trial` (Task 2): the student's filter run on one trial both ways,
+  its estimated positions and their MSEs, recomputed from the task's draw with the engine;
+- :func:`check_fusion_difference` (Task 3): the per-run MSEs over the Monte Carlo runs and
+  the paired vision-only − fused differences after the first second and over the whole
+  trial, recomputed with :func:`lqe_helpers.experiments.track`.
+
+The checks of the Going further tasks are in :mod:`lqe_helpers.checks.fusion_further`.
+"""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from .machinery import MATRIX_RTOL, CheckFailed, argument_array, passed, positive_number
+from .. import experiments, metrics
+from ..scenario import DEFAULT
+from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .machinery import (
+    FUNCTION_RTOL,
+    INTERVAL_RTOL,
+    MATRIX_RTOL,
+    MSE_RTOL,
+    CheckFailed,
+    argument_array,
+    passed,
+    positive_number,
+    tolerance_text,
+)
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+#: The fused filter's sensors, in the column order of its readings, C and R.
+FUSED = ("vision", "proprioception")
 
 
 def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
@@ -104,3 +132,238 @@ def _check_fusion_R(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
     raise CheckFailed(
         f"R's diagonal is {diag.tolist()} cm²; for σ_v = {sigma_v:g} cm and σ_p = "
         f"{sigma_p:g} cm it must hold their variances")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 2: one trial, filtered both ways
+# ------------------------------------------------------------------------------------------
+
+def engine_positions(readings: np.ndarray, sigmas: list[float], column: int = 0) -> np.ndarray:
+    """Column ``column`` of the engine's estimates on ``readings`` (n, m), R = diag(σ²).
+
+    The model is the tasks' (:func:`lqe_helpers.experiments.filter_model` of the first m
+    senses): DEFAULT's A, Q, z0 and P0, C with one position row per sense. Shared with
+    :mod:`~lqe_helpers.checks.fusion_further`.
+    """
+    senses = FUSED[:readings.shape[-1]]
+    return experiments.filter_model(DEFAULT, senses, sigmas=sigmas).filter(
+        readings).estimates[..., column]
+
+
+@functools.cache
+def _trial() -> dict[str, object]:
+    """Task 2's right positions (n,) and MSEs (cm²), and the likely mistakes of each."""
+    tracking = experiments.track(DEFAULT, FUSED)
+    y = tracking.measurements
+    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
+    sigma_v, sigma_p = DEFAULT.sigma_v, DEFAULT.sigma_p
+    fused = tracking.positions
+    vision = engine_positions(y[:, :1], [sigma_v])
+    root = {"vision": [np.sqrt(sigma_v)], "fused": [np.sqrt(sigma_v), np.sqrt(sigma_p)]}
+    velocity = "it is column 1 of the estimates, the velocity (cm/s): the position is column 0"
+    sigma_for_variance = ("R holds σ (cm) where the variance σ² (cm²) belongs, so the filter "
+                          "weighs the readings wrongly")
+    positions = {"vision": vision, "fused": fused}
+    mistakes = {
+        "vision": {
+            "it is the fused filter's estimate: vision_positions comes from the filter given "
+            "vision alone (column 0 of y, row 0 of C, the top-left entry of R)": fused,
+            "it is the filter run on proprioception's readings (column 1 of y): vision's "
+            "readings are column 0": engine_positions(y[:, 1:], [sigma_p]),
+            velocity: engine_positions(y[:, :1], [sigma_v], 1),
+            sigma_for_variance: engine_positions(y[:, :1], root["vision"]),
+            "these are vision's readings, not the filter's estimate": y[:, 0],
+        },
+        "fused": {
+            "it is the vision-only filter's estimate: fused_positions comes from the filter "
+            "given both senses (all of y, C and R)": vision,
+            "the two readings were averaged and filtered as one sense with vision's R: the "
+            "filter of both senses needs no averaging; give it both columns of the readings "
+            "with your C and R":
+                engine_positions(y.mean(axis=1, keepdims=True), [sigma_v]),
+            velocity: engine_positions(y, [sigma_v, sigma_p], 1),
+            sigma_for_variance: engine_positions(y, root["fused"]),
+            "these are vision's readings, not the filter's estimate": y[:, 0],
+        },
+    }
+
+    def mse(x: np.ndarray) -> float:
+        return float(metrics.mse(x, truth, burn))
+
+    mse_wrong = {}
+    for kind, other in (("vision", "fused"), ("fused", "vision")):
+        mse_wrong[kind] = {
+            f"it is the MSE of the {'fused' if kind == 'vision' else 'vision-only'} "
+            f"filter's estimate": mse(positions[other]),
+            "it is the MSE of vision's raw readings, not of the filter's estimate":
+                mse(y[:, 0]),
+            **{f"it comes from a wrong estimate: {cause}": mse(wrong)
+               for cause, wrong in mistakes[kind].items() if wrong is not positions[other]},
+            **mse_mistakes(positions[kind], truth, burn, dt),
+        }
+    return {"positions": positions, "mistakes": mistakes,
+            "mse": {kind: mse(value) for kind, value in positions.items()},
+            "mse_mistakes": mse_wrong}
+
+
+def _positions_answer(value: object, name: str, n: int) -> np.ndarray:
+    """The student's positions as an array, or CheckFailed naming a wrong shape."""
+    array = argument_array(value, name, f"the estimated positions (cm), an array of shape "
+                                        f"({n},)")
+    if array.ndim == 2 and array.shape[0] == n:
+        raise CheckFailed(
+            f"{name} has shape {array.shape}: it holds {array.shape[1]} column(s) of "
+            f"estimates. Keep only column 0, the position, as a flat array of shape ({n},)")
+    return array
+
+
+def check_fusion_trial(vision_positions: np.ndarray, fused_positions: np.ndarray,
+                       mse_vision_trial: float, mse_fused_trial: float) -> None:
+    """Check Task 2: one trial filtered with vision alone and with both senses, and its MSEs.
+
+    Recomputed from the task's own inputs before looking at the student's: the scenario's
+    trial of both senses (:func:`lqe_helpers.experiments.track`, σ_v = σ_p = 1.5 cm),
+    filtered by the pack's engine with both senses (C with two position rows,
+    ``R = diag(σ_v², σ_p²)``) and with vision alone (column 0, ``R = [[σ_v²]]``), from
+    ``DEFAULT.z0`` and ``P0 = diag(1, 1, 1)``. The positions (cm) must agree within
+    :data:`FUNCTION_RTOL` of their largest value, each MSE (cm²) after the first
+    ``DEFAULT.burn_in_steps`` samples within :data:`MSE_RTOL` relative.
+
+    Parameters
+    ----------
+    vision_positions, fused_positions : array_like, shape (n,)
+        The student's estimated positions (cm): column 0 of their filter's estimates.
+    mse_vision_trial, mse_fused_trial : float
+        The student's MSEs (cm²) after the burn-in.
+
+    Raises
+    ------
+    CheckFailed
+        Naming the value and the likely cause: the two filters swapped, proprioception's
+        column for vision's, the velocity column, σ where σ² belongs, the readings
+        averaged, the raw readings, the whole trial, the burn-in in seconds, the RMSE, ...
+    """
+    right = _trial()
+    n = DEFAULT.n_steps
+    for kind, name, value in (("vision", "vision_positions", vision_positions),
+                              ("fused", "fused_positions", fused_positions)):
+        judge(name, _positions_answer(value, name, n), right["positions"][kind],
+              FUNCTION_RTOL, unit="cm", mistakes=right["mistakes"][kind],
+              what=f"the {'vision-only' if kind == 'vision' else 'fused'} filter's positions "
+                   f"recomputed from the task's trial")
+    for kind, name, value in (("vision", "mse_vision_trial", mse_vision_trial),
+                              ("fused", "mse_fused_trial", mse_fused_trial)):
+        judge(name, value, right["mse"][kind], MSE_RTOL, unit="cm²",
+              mistakes=right["mse_mistakes"][kind],
+              what=f"the {'vision-only' if kind == 'vision' else 'fused'} MSE recomputed "
+                   f"from the task's trial")
+    passed(f"both filters' positions match the pack's engine on the task's trial to "
+           f"{tolerance_text(FUNCTION_RTOL)} of the largest, and both MSEs (after the first "
+           f"{DEFAULT.burn_in_steps} samples) to {tolerance_text(MSE_RTOL)} relative")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 3: many trials, compared pair by pair
+# ------------------------------------------------------------------------------------------
+
+@functools.cache
+def monte_carlo_mses() -> dict[str, np.ndarray]:
+    """Task 3's runs: positions (runs, n) (cm) and per-run MSEs (runs,) (cm²), read-only.
+
+    Keys ``vision`` and ``fused`` (positions), ``<filter>_after`` (after the burn-in),
+    ``<filter>_whole``, ``raw`` (vision's readings). Shared with
+    :mod:`~lqe_helpers.checks.fusion_further`.
+    """
+    runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
+    vision = experiments.track(DEFAULT, ("vision",), runs=runs)
+    fused = experiments.track(DEFAULT, FUSED, runs=runs)
+    values = {"vision": vision.positions, "fused": fused.positions,
+              "raw": vision.measurement_mse("vision")}
+    for kind in ("vision", "fused"):
+        values[f"{kind}_after"] = metrics.mse(values[kind], truth, burn)
+        values[f"{kind}_whole"] = metrics.mse(values[kind], truth)
+        if burn * DEFAULT.dt >= 1:  # the burn-in given in seconds: int(1 s) samples
+            values[f"{kind}_seconds"] = metrics.mse(values[kind], truth,
+                                                    int(burn * DEFAULT.dt))
+    for array in values.values():
+        array.setflags(write=False)
+    return values
+
+
+def _per_run(value: object, name: str, runs: int) -> np.ndarray:
+    """The student's per-run MSEs as an array, or CheckFailed if it is one number."""
+    array = argument_array(value, name, f"one MSE per run (cm²), an array of shape ({runs},)")
+    if array.size == 1:
+        raise CheckFailed(
+            f"{name} is one number; the task asks for one MSE per run, shape ({runs},): "
+            f"metrics.mse of positions of shape (runs, n) gives them")
+    return array
+
+
+def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
+                            difference: metrics.Interval,
+                            whole_difference: metrics.Interval) -> None:
+    """Check Task 3: per-run MSEs of both filters and their paired differences.
+
+    Recomputed from the task's inputs before looking at the student's:
+    ``DEFAULT.mc_runs`` runs of vision alone and of both senses
+    (:func:`lqe_helpers.experiments.track`; run r of both on the same visual noise), the
+    per-run MSEs after the first ``DEFAULT.burn_in_steps`` samples (each within
+    :data:`MSE_RTOL` relative) and over the whole trial, and ``metrics.mean_ci95`` of the
+    per-run differences vision only − fused in both windows (mean and ends within
+    :data:`INTERVAL_RTOL` of the interval's scale).
+
+    Parameters
+    ----------
+    mse_vision, mse_fused : array_like, shape (runs,)
+        The student's per-run MSEs (cm²) after the first second.
+    difference, whole_difference : metrics.Interval
+        The student's paired differences (cm²) after the first second and over the whole
+        trial.
+
+    Raises
+    ------
+    CheckFailed
+        Naming the value and the likely cause: the two filters swapped, the windows
+        swapped, the sign reversed, an unpaired interval, a ratio or a percentage, the
+        standard deviation for the standard error, one run, ...
+    """
+    values = monte_carlo_mses()
+    runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
+    for kind, other, name, value in (("vision", "fused", "mse_vision", mse_vision),
+                                     ("fused", "vision", "mse_fused", mse_fused)):
+        label = "vision-only" if kind == "vision" else "fused"
+        judge(name, _per_run(value, name, runs), values[f"{kind}_after"], MSE_RTOL,
+              unit="cm²", what=f"the {label} MSEs recomputed from the task's runs",
+              mistakes={
+                  f"these are the {'fused' if kind == 'vision' else 'vision-only'} filter's "
+                  f"MSEs": values[f"{other}_after"],
+                  "these are the MSEs of vision's raw readings, not of the filter's "
+                  "estimates": values["raw"],
+                  **mse_mistakes(values[kind], truth, burn, DEFAULT.dt)})
+    windows = {"after": ("difference", difference, "after the first second (from burn_in on)"),
+               "whole": ("whole_difference", whole_difference, "over the whole trial")}
+    for window, (name, interval, said) in windows.items():
+        vision, fused = values[f"vision_{window}"], values[f"fused_{window}"]
+        other = "whole" if window == "after" else "after"
+        mistakes = {
+            **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE"),
+            f"it is the difference {windows[other][2]}; {name} is the one {said}":
+                metrics.mean_ci95(values[f"vision_{other}"] - values[f"fused_{other}"]),
+            "it is the interval of the ratio vision only / fused; the task asks for the "
+            "paired difference vision only − fused (cm²)": metrics.mean_ci95(vision / fused),
+            "it is the relative difference in % of the vision-only MSE; the task asks for "
+            "the difference itself (cm²)": metrics.mean_ci95(100 * (vision - fused) / vision),
+        }
+        if window == "after" and "vision_seconds" in values:
+            mistakes[f"it leaves out the first {burn * DEFAULT.dt:g} sample(s): the burn-in "
+                     f"is {burn * DEFAULT.dt:g} s, which is {burn} samples"] = (
+                metrics.mean_ci95(values["vision_seconds"] - values["fused_seconds"]))
+        judge_interval(name, interval, metrics.mean_ci95(vision - fused), INTERVAL_RTOL,
+                       unit="cm²", mistakes=mistakes,
+                       what=f"the paired difference vision only − fused {said}, recomputed "
+                            f"from the task's runs")
+    passed(f"per-run MSEs of both filters over {runs} runs match the pack's engine to "
+           f"{tolerance_text(MSE_RTOL)} relative, and the paired differences vision only − "
+           f"fused after the first second and over the whole trial (mean and 95 % interval) "
+           f"to {tolerance_text(INTERVAL_RTOL)}")

@@ -96,18 +96,18 @@ def require_callable(function: object, what: str, check: str) -> str:
 
 def call_student(function: Callable, *args: object, name: str, where: str,
                  arg_names: Sequence[str] | None = None, hint: str = "",
-                 shape_hint: str = "") -> object:
+                 shape_hint: str = "", forbid: Sequence[Callable] = ()) -> object:
     """``student_code.call`` for a check: every failure becomes one CheckFailed.
 
     NotImplementedError becomes :class:`NotWrittenYet` and a time-out :class:`TimedOut`
     (:data:`STOP_CALLING`: a check stops at once, calling again would not help);
-    everything else (an exception, an input changed in place, ...) a
-    :class:`CheckFailed` with the same message that shows the student's own lines where
-    it happened.
+    everything else (an exception, an input changed in place, a ``forbid`` function of the
+    pack run, ...) a :class:`CheckFailed` with the same message that shows the student's
+    own lines where it happened.
     """
     try:
         return student_code.call(function, *args, name=name, where=where, arg_names=arg_names,
-                                 hint=hint, shape_hint=shape_hint)
+                                 hint=hint, shape_hint=shape_hint, forbid=forbid)
     except student_code.NotWrittenYet as error:
         failure: CheckFailed = NotWrittenYet(str(error))
     except student_code.TimedOut as error:

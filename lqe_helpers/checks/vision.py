@@ -6,6 +6,10 @@
   recomputed from the scenario's draw with the engine;
 - :func:`check_vision_difference` (Task 3): the paired raw − filtered difference over
   the Monte Carlo runs, recomputed with :func:`lqe_helpers.experiments.track`.
+
+:func:`monte_carlo` (Task 3's runs) and :func:`keyed` (a student's dict keyed by σ_v or
+Δt) serve the Going further checks too (:mod:`~lqe_helpers.checks.vision_smoothers`,
+:mod:`~lqe_helpers.checks.vision_further`).
 """
 
 from __future__ import annotations
@@ -228,23 +232,49 @@ def _trial_mses(sigma_v: float) -> dict[str, object]:
             "filtered_mistakes": filtered_mistakes, "other": other}
 
 
-def _by_sigma(values: object, name: str, what: str) -> dict[float, object]:
-    """The student's dict keyed by σ_v (cm), with both of the question's levels in it."""
+def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS_V,
+          key: str = "σ_v", unit: str = "cm") -> dict[float, object]:
+    """The student's dict keyed by numbers (σ_v in cm, Δt in s), with every key due in it.
+
+    Parameters
+    ----------
+    values : object
+        What the student passed, e.g. ``mse_filtered``.
+    name : str
+        Its name, for messages.
+    what : str
+        What its values are ("MSEs (cm²) of the readings").
+    keys : tuple of float
+        The keys the task asks for, in order.
+    key, unit : str
+        What the keys are and their unit, for messages.
+
+    Returns
+    -------
+    dict of float to object
+        The student's values by float key (numpy numbers and ints count as floats).
+
+    Raises
+    ------
+    CheckFailed
+        If ``values`` is not a dict, or a key due is missing.
+    """
     if not isinstance(values, dict):
         found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by σ_v (cm), e.g. "
-                          f"{name}[4.5], got {found}")
-    keys = {}
-    for key in values:
-        if isinstance(key, (int, float, np.number)) and not isinstance(key, bool):
-            keys[float(key)] = values[key]
-    missing = [sigma for sigma in SIGMAS_V if sigma not in keys]
+        raise CheckFailed(f"{name} must be a dict of {what} keyed by {key} ({unit}), e.g. "
+                          f"{name}[{keys[-1]:g}], got {found}")
+    found_keys = {}
+    for item in values:
+        if isinstance(item, (int, float, np.number)) and not isinstance(item, bool):
+            found_keys[float(item)] = values[item]
+    missing = [value for value in keys if value not in found_keys]
     if missing:
-        have = ", ".join(repr(key) for key in values) or "none"
-        raise CheckFailed(f"{name} has no entry for σ_v = {missing[0]:g} cm (its keys: "
-                          f"{have}); the task asks for both noise levels, keyed by the number "
-                          f"σ_v itself")
-    return keys
+        have = ", ".join(repr(item) for item in values) or "none"
+        raise CheckFailed(f"{name} has no entry for {key} = {missing[0]:g} {unit} (its keys: "
+                          f"{have}); the task asks for {key} = "
+                          f"{', '.join(f'{value:g}' for value in keys)} {unit}, keyed by the "
+                          f"number {key} itself")
+    return found_keys
 
 
 def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float, float]) -> None:
@@ -268,8 +298,8 @@ def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float,
         other noise level, the readings' MSE for the estimate's, readings made without
         σ_v, the whole trial, the burn-in in seconds, the RMSE, ...
     """
-    readings = _by_sigma(mse_readings, "mse_readings", "MSEs (cm²) of the readings")
-    filtered = _by_sigma(mse_filtered, "mse_filtered", "MSEs (cm²) of the estimates")
+    readings = keyed(mse_readings, "mse_readings", "MSEs (cm²) of the readings")
+    filtered = keyed(mse_filtered, "mse_filtered", "MSEs (cm²) of the estimates")
     for sigma in SIGMAS_V:
         right = _trial_mses(sigma)
         other = _trial_mses(right["other"])
@@ -291,9 +321,20 @@ def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float,
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
-def _monte_carlo() -> dict[str, np.ndarray]:
-    """Per-run MSEs (runs, 2) of the readings and estimates at both σ_v (cm²), read-only."""
-    batch = experiments.track(DEFAULT, sigmas=[[s] for s in SIGMAS_V], runs=DEFAULT.mc_runs)
+def monte_carlo() -> experiments.Tracking:
+    """Task 3's runs: ``DEFAULT.mc_runs`` runs at σ_v = 1.5 and 4.5 cm, shape (runs, 2, ...).
+
+    The engine's batch of the scenario's draws, the same as the notebook's ``batch``;
+    computed once and shared by the checks of notebook 01 (none hands it to a student's
+    function).
+    """
+    return experiments.track(DEFAULT, sigmas=[[s] for s in SIGMAS_V], runs=DEFAULT.mc_runs)
+
+
+@functools.cache
+def _monte_carlo_mses() -> dict[str, np.ndarray]:
+    """Per-run MSEs (runs, 2) of the readings and estimates at both σ_v (cm², read-only)."""
+    batch = monte_carlo()
     truth = DEFAULT.truth[:, 0]
     values = {"raw": batch.measurement_mse("vision"), "filtered": batch.mse(),
               "raw_whole": metrics.mse(batch.measurements[..., 0], truth),
@@ -323,8 +364,8 @@ def check_vision_difference(improvement: dict[float, metrics.Interval]) -> None:
         the whole trial, the other noise level, a ratio instead of a difference, one
         MSE alone, the standard deviation for the standard error, ...
     """
-    intervals = _by_sigma(improvement, "improvement", "paired intervals (metrics.Interval)")
-    runs = _monte_carlo()
+    intervals = keyed(improvement, "improvement", "paired intervals (metrics.Interval)")
+    runs = _monte_carlo_mses()
     for column, sigma in enumerate(SIGMAS_V):
         raw, filtered = runs["raw"][:, column], runs["filtered"][:, column]
         other = runs["raw"][:, 1 - column] - runs["filtered"][:, 1 - column]

@@ -7,10 +7,17 @@ trust between the senses once its gain has settled: the shares of the position
 correction, which follow the reliabilities ``1/σ_v²`` and ``1/σ_p²``, each printed on
 its bar. Both σ's and the trial's MSEs are not drawn in the figure: the drawing
 function returns them as one line of text, shown between the sliders and the picture.
+
+Given the student's own filter (``explore_fusion(filter=my_filter)``), the sliders run it
+for both estimates (through :func:`lqe_helpers.student_code.call`, so a hang is stopped
+and a failure is one line in the explorer), and the numbers line says whose filter it
+is. The ±2 SD band and the shares come from the engine's covariances and gain, which do
+not depend on the readings: a student's ``my_filter`` returns estimates only.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -21,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 from matplotlib.text import Annotation
 
-from .. import experiments, validation
+from .. import experiments, student_code, validation
 from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -60,6 +67,13 @@ _BAND = "fused band"
 _BAND_LABEL = "fused filter's own ±2 SD"
 #: Title of the right panel; it never changes, so it stays in the cached background.
 SHARES_TITLE = "weights ∝ reliability 1/σ²"
+#: The arguments of a student's filter, in order (notebook 01's ``my_filter``).
+FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+#: What the numbers line says runs the filters when no student's filter is given.
+ENGINE = "the pack's engine"
+
+#: A student's filter ``my_filter(y, A, C, Q, R, z0, P0) -> estimates (n, k)``.
+StudentFilter = Callable[..., object]
 
 
 def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarray:
@@ -73,28 +87,78 @@ def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarra
                                    ", ".join(FUSED))
 
 
-def vision_only(scenario: Scenario, sigma_v: float, noise: np.ndarray) -> experiments.Tracking:
+def student_filter(filter: StudentFilter | None) -> StudentFilter | None:
+    """``filter`` checked: None (the pack's engine) or a function, else ValueError."""
+    if filter is not None and not callable(filter):
+        raise ValueError(f"filter must be your filter function (e.g. my_filter, without "
+                         f"parentheses) or None for the pack's engine, got a "
+                         f"{type(filter).__name__}")
+    return filter
+
+
+def whose(filter: StudentFilter | None) -> str:
+    """Whose filter runs: "your my_filter" or :data:`ENGINE`."""
+    return ENGINE if filter is None else f"your {student_code.function_name(filter)}"
+
+
+def with_student_estimates(tracking: experiments.Tracking,
+                           filter: StudentFilter | None) -> experiments.Tracking:
+    """``tracking`` with its estimates replaced by ``filter``'s on the same readings and model.
+
+    The student's function runs through :func:`lqe_helpers.student_code.call` on
+    ``tracking``'s readings (n, m) and model (A, C, Q, R, z0, P0) and must return the
+    estimates, shape (n, 3). The gains and covariances stay the engine's: they do not
+    depend on the readings. None returns ``tracking`` itself.
+
+    Raises
+    ------
+    StudentCodeError
+        One line, if the function is not written yet, raises, hangs, or returns anything
+        but a real array of shape (n, 3).
+    """
+    if filter is None:
+        return tracking
+    model, sensors = tracking.model, tracking.sensors
+    name = student_code.function_name(filter)
+    n, k = tracking.result.estimates.shape
+    estimates = student_code.call(
+        filter, tracking.measurements, model.A, model.C, model.Q, model.R, model.z0,
+        model.P0, name=name, arg_names=FILTER_ARGS, rerun="move a slider to try again",
+        where=f"the explorer's trial of {' and '.join(sensors)}")
+    estimates = student_code.result_array(
+        estimates, name=name, shape=(n, k), where="the explorer's trial",
+        what=f"the estimates ẑ, an array of shape (n, k) = ({n}, {k})")
+    return dataclasses.replace(
+        tracking, result=dataclasses.replace(tracking.result, estimates=estimates))
+
+
+def vision_only(scenario: Scenario, sigma_v: float, noise: np.ndarray,
+                filter: StudentFilter | None = None) -> experiments.Tracking:
     """Vision-only tracking of one trial with unit noise ``noise[:, 0]`` scaled by ``sigma_v``.
 
-    ``noise`` (n, 2) as :func:`unit_noise` gives it. Moving σ_p does not change this
-    run, so the explorers keep it between moves
+    ``noise`` (n, 2) as :func:`unit_noise` gives it; ``filter`` a student's filter that
+    makes the estimates (:func:`with_student_estimates`), or None for the engine's.
+    Moving σ_p does not change this run, so the explorers keep it between moves
     (:class:`~lqe_helpers.explorers.cache.LastResults`).
     """
-    return experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
+    tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
+    return with_student_estimates(tracking, filter)
 
 
 def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
-                scenario: Scenario = DEFAULT, noise: np.ndarray | None = None) -> str:
+                scenario: Scenario = DEFAULT, noise: np.ndarray | None = None,
+                filter: StudentFilter | None = None) -> str:
     """Draw vision-only and fused tracking of one trial at ``sigma_v`` and ``sigma_p``.
 
     Both filters see the same visual readings; the fused one also sees proprioception
     (C with two rows ``[1, 0, 0]``, ``R = diag(σ_v², σ_p²)``, Tutorial eq. (6)). Top
     left: readings, true position and both estimates. Bottom left: both errors
     (estimate − true position) with the fused filter's own ±2 SD band. Right: each
-    sense's share of the settled position gain, in % on its bar. Returns both σ's and
-    this trial's MSEs after the scenario's burn-in as one line of text (the explorer
-    shows it beside the figure), e.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE of this trial
-    after 1 s: vision only 0.304 cm², fused 0.274 cm²."
+    sense's share of the settled position gain, in % on its bar. Returns both σ's,
+    this trial's MSEs after the scenario's burn-in and whose filter ran as one line of
+    text (the explorer shows it beside the figure), e.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE
+    of this trial after 1 s: vision only 0.304 cm², fused 0.274 cm². Filter: your
+    my_filter."
 
     A figure this function drew before (for the same scenario) keeps its panels and
     only has its data replaced, which halves the redraw time of a slider; any other
@@ -113,11 +177,16 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     noise : array_like, shape (n, 2), optional
         Unit noise of vision (column 0) and proprioception (column 1), scaled by the
         σ's; default the scenario's fixed draw. The vision-only filter uses column 0.
+    filter : callable, optional
+        The student's ``my_filter(y, A, C, Q, R, z0, P0)``, returning the estimates
+        (n, 3): it makes both estimates (:func:`with_student_estimates`). Default: the
+        pack's engine.
 
     Returns
     -------
     str
-        Both σ's (cm) and the trial's MSEs (cm²) of both filters after the burn-in.
+        Both σ's (cm), the trial's MSEs (cm²) of both filters after the burn-in, and
+        whose filter ran.
 
     Notes
     -----
@@ -129,21 +198,27 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     Raises
     ------
     ValueError
-        If a σ is not a finite number > 0, or ``noise`` has the wrong shape.
+        If a σ is not a finite number > 0, ``noise`` has the wrong shape, or ``filter``
+        is neither None nor a function.
+    StudentCodeError
+        If the student's filter fails (one line, see :func:`with_student_estimates`).
     """
     noise = unit_noise(scenario, noise)
+    filter = student_filter(filter)
     return _draw(figure, sigma_v=validation.positive("sigma_v", sigma_v, "cm"),
                  sigma_p=validation.positive("sigma_p", sigma_p, "cm"), scenario=scenario,
-                 noise=noise, vision_runs=partial(vision_only, scenario, noise=noise))
+                 noise=noise, filter=filter,
+                 vision_runs=partial(vision_only, scenario, noise=noise, filter=filter))
 
 
 def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
-          noise: np.ndarray,
+          noise: np.ndarray, filter: StudentFilter | None,
           vision_runs: Callable[[float], experiments.Tracking]) -> str:
-    """:func:`draw_fusion` of σ's already checked; ``vision_runs(σ_v)`` makes or keeps
-    the vision-only run."""
+    """:func:`draw_fusion` of inputs already checked; ``vision_runs(σ_v)`` makes or keeps
+    the vision-only run (with ``filter``'s estimates)."""
     vision = vision_runs(sigma_v)
-    fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
+    fused = with_student_estimates(
+        experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise), filter)
     truth = scenario.truth[:, 0]
     # Share of the position correction each sense receives in the settled filter: the
     # reliability weights 1/σ² normalised, read off the fused filter's own gain.
@@ -163,7 +238,7 @@ def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
         bar.set_height(weight)
         text.set_text(f"{100 * weight:.0f} %")
         text.xy = (bar.get_x() + bar.get_width() / 2, weight)
-    return trial_numbers(scenario, sigma_v, sigma_p, vision, fused)
+    return f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} Filter: {whose(filter)}."
 
 
 class _Panels(NamedTuple):
@@ -214,12 +289,19 @@ def describe_fusion(*, sigma_v: float, sigma_p: float) -> str:
     """What :func:`draw_fusion` shows at ``sigma_v`` and ``sigma_p`` (its alt text)."""
     return (f"One trial at σ_v = {sigma_v:.2f} cm and σ_p = {sigma_p:.2f} cm. Top left: true "
             f"position, both senses' readings, the vision-only and the fused estimate; bottom "
-            f"left: their errors with the fused filter's ±2 SD band; right: each sense's share "
+            f"left: their errors with the fused filter's ±2 SD band (from the engine's "
+            f"covariances, which do not depend on the readings); right: each sense's share "
             f"of the position correction.")
 
 
-def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
+def explore_fusion(scenario: Scenario = DEFAULT, *,
+                   filter: StudentFilter | None = None) -> Explorer:
     """Sliders for σ_v and σ_p over vision-only and fused tracking of one fixed trial.
+
+    ``filter`` is the student's ``my_filter(y, A, C, Q, R, z0, P0)``: the sliders then run
+    it for both estimates, and the numbers line says so; a failure of it shows as one
+    line in place of the numbers (:attr:`Explorer.problem`), and the next move tries
+    again. Default: the pack's engine.
 
     The unit noise is drawn once from the scenario's explorer seed (another draw than
     the tasks', :func:`~lqe_helpers.explorers.base.with_explorer_seed`) and kept, so a
@@ -231,8 +313,9 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
     ------
     ValueError
         If ``scenario.sigma_v`` or ``scenario.sigma_p`` lies outside the sliders' range
-        :data:`SIGMA_RANGE`.
+        :data:`SIGMA_RANGE`, or ``filter`` is neither None nor a function.
     """
+    filter = student_filter(filter)
     low, high, step = SIGMA_RANGE
     start_v = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
     start_p = starting_value("sigma_p", scenario.sigma_p, low, high, "cm")
@@ -243,7 +326,9 @@ def explore_fusion(scenario: Scenario = DEFAULT) -> Explorer:
     noise = unit_noise(with_explorer_seed(scenario))
     # The vision-only runs of the last VISION_RUNS_KEPT σ_v: moving σ_p, or σ_v back to a
     # recent value, reuses one.
-    vision_runs = LastResults(partial(vision_only, scenario, noise=noise), size=VISION_RUNS_KEPT)
-    draw = partial(_draw, scenario=scenario, noise=noise, vision_runs=vision_runs)
-    return Explorer("Vision alone against vision + proprioception", sliders, draw,
-                    figsize=(10.0, 5.0), describe=describe_fusion)
+    vision_runs = LastResults(partial(vision_only, scenario, noise=noise, filter=filter),
+                              size=VISION_RUNS_KEPT)
+    draw = partial(_draw, scenario=scenario, noise=noise, filter=filter,
+                   vision_runs=vision_runs)
+    return Explorer(f"Vision alone against vision + proprioception ({whose(filter)})",
+                    sliders, draw, figsize=(10.0, 5.0), describe=describe_fusion)

@@ -5,12 +5,20 @@ one trial: the butterfly, the vision-only and the fused estimate, and their erro
 The right panel places the slider's σ_p on the theoretical curve of the fused
 filter's steady-state position variance, below the vision-only level that the
 curve approaches but never crosses. The numbers of the view (both σ's, the trial's
-MSEs, proprioception's weight) are not drawn in the figure: the drawing function
-returns them as one line of text, shown between the slider and the picture.
+MSEs, proprioception's weight, whose filter made the estimates) are not drawn in the
+figure: the drawing function returns them as one line of text, shown between the
+slider and the picture.
+
+Given the student's own filter (``filter=my_filter``, notebook 01's function), the
+estimates of the trial are the student's, run through
+:func:`lqe_helpers.student_code.call` (copies of the inputs, a time limit; a failure is
+one line in the explorer); the theory curve and the weight come from the pack's steady
+state, which does not depend on the readings.
 """
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -20,7 +28,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
-from .. import experiments, validation
+from .. import experiments, student_code, validation
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -53,6 +61,11 @@ CURVE_RANGE = (0.3, 100.0)
 
 #: Title of the right panel; it never changes, so it stays in the cached background.
 THEORY_TITLE = "steady state"
+
+#: The parameters of a student's filter, in order (notebook 01's ``my_filter``).
+FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+#: The filter a student's function stands in for: the numbers line names it otherwise.
+ENGINE = "the pack's engine"
 
 #: Plotted lines of the left column by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
@@ -101,17 +114,19 @@ def steady_position_variances(scenario: Scenario, sigma_v: float,
 
 def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
                                 scenario: Scenario = DEFAULT,
-                                noise: np.ndarray | None = None) -> str:
+                                noise: np.ndarray | None = None,
+                                filter: Callable[..., np.ndarray] | None = None) -> str:
     """Draw one trial of vision-only and fused tracking at ``sigma_p`` on ``figure``.
 
     Top left: true position and both estimates. Bottom left: both errors (estimate −
     true position). Right: the fused filter's theoretical steady-state position
     variance against σ_p (log axis), the vision-only level, and a marker at
-    ``sigma_p``. Returns both σ's, this trial's MSEs after the scenario's burn-in and
-    proprioception's share of the settled position gain as one line of text (the
-    explorer shows it beside the figure), e.g. "σ_v = 1.5 cm, σ_p = 4.5 cm. MSE of
-    this trial after 1 s: vision only 0.304 cm², fused 0.274 cm². Proprioception's
-    weight in the steady state: 10.0 %."
+    ``sigma_p``. Returns both σ's, this trial's MSEs after the scenario's burn-in,
+    proprioception's share of the settled position gain and whose filter made the
+    estimates as one line of text (the explorer shows it beside the figure), e.g.
+    "σ_v = 1.5 cm, σ_p = 4.5 cm. MSE of this trial after 1 s: vision only 0.304 cm²,
+    fused 0.274 cm². Proprioception's weight in the steady state: 10.0 %. Estimates
+    from your my_filter."
 
     A figure this function drew before (for the same scenario) keeps its panels and
     only has its data replaced, which halves the redraw time of a slider; any other
@@ -128,12 +143,16 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     noise : array_like, shape (n, 2), optional
         Unit noise of vision (column 0) and proprioception (column 1); default the
         scenario's fixed draw. The vision-only filter uses column 0.
+    filter : callable, optional
+        The student's filter ``filter(y, A, C, Q, R, z0, P0) -> estimates (n, k)``
+        (notebook 01's ``my_filter``), run on the trial's readings with each filter's
+        model (:func:`lqe_helpers.experiments.filter_model`); default the pack's engine.
 
     Returns
     -------
     str
-        Both σ's (cm), the trial's MSEs (cm²) of both filters after the burn-in and
-        proprioception's weight (%, one decimal).
+        Both σ's (cm), the trial's MSEs (cm²) of both filters after the burn-in,
+        proprioception's weight (%, one decimal) and whose filter it is.
 
     Notes
     -----
@@ -144,21 +163,66 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     Raises
     ------
     ValueError
-        If ``sigma_p`` is not a finite number > 0, or ``noise`` has the wrong shape.
+        If ``sigma_p`` is not a finite number > 0, ``noise`` has the wrong shape, or
+        ``filter`` is neither None nor a function.
+    StudentCodeError
+        If ``filter`` fails: raises, does not return in time, or returns something
+        other than the estimates (one line; the explorer shows it).
     """
     noise = unit_noise(scenario, noise)
+    if filter is not None and not callable(filter):
+        raise ValueError(f"filter must be a function such as my_filter, or None for the "
+                         f"pack's engine, got a {type(filter).__name__}")
     return _draw(figure, sigma_p=validation.positive("sigma_p", sigma_p, "cm"),
-                 scenario=scenario, noise=noise,
-                 vision_run=partial(vision_only, scenario, scenario.sigma_v, noise))
+                 scenario=scenario, noise=noise, filter=filter,
+                 vision_run=partial(_vision_run, scenario, noise, filter))
+
+
+def run_by(filter: Callable[..., np.ndarray] | None,
+           tracking: experiments.Tracking, where: str) -> experiments.Tracking:
+    """``tracking`` with its estimates made by ``filter`` from the same readings and model.
+
+    ``filter(y, A, C, Q, R, z0, P0)`` (a student's function) is called through
+    :func:`lqe_helpers.student_code.call` on the tracking's readings (n, m) and the
+    model it assumed, and must return the estimates, shape (n, k). The covariances
+    stay the engine's: they do not depend on the readings. None keeps the engine's run.
+
+    Raises
+    ------
+    StudentCodeError
+        One line naming what went wrong and ``where``.
+    """
+    if filter is None:
+        return tracking
+    name = student_code.function_name(filter)
+    m = tracking.model
+    shape = tracking.result.estimates.shape
+    value = student_code.call(filter, tracking.measurements, m.A, m.C, m.Q, m.R, m.z0, m.P0,
+                              name=name, where=where, arg_names=FILTER_ARGS,
+                              rerun="move the slider again")
+    estimates = student_code.result_array(value, name=name, shape=shape, where=where,
+                                          what=f"the estimates ẑ, shape (n, k) = {shape}")
+    return dataclasses.replace(tracking,
+                               result=dataclasses.replace(tracking.result, estimates=estimates))
+
+
+def _vision_run(scenario: Scenario, noise: np.ndarray,
+                filter: Callable[..., np.ndarray] | None) -> experiments.Tracking:
+    """The vision-only run of the trial at the scenario's σ_v, by ``filter``."""
+    return run_by(filter, vision_only(scenario, scenario.sigma_v, noise),
+                  f"the explorer's trial with vision alone, σ_v = {scenario.sigma_v:g} cm")
 
 
 def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarray,
-          vision_run: Callable[[], experiments.Tracking]) -> str:
+          vision_run: Callable[[], experiments.Tracking],
+          filter: Callable[..., np.ndarray] | None) -> str:
     """:func:`draw_noisier_proprioception` of a σ_p already checked; ``vision_run()``
     makes or keeps the vision-only run (σ_v is the scenario's, whatever the slider)."""
     sigma_v = scenario.sigma_v
     vision = vision_run()
-    fused = experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise)
+    fused = run_by(filter, experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p],
+                                             noise=noise),
+                   f"the explorer's trial with both senses, σ_p = {sigma_p:g} cm")
     truth = scenario.truth[:, 0]
     # The theory at the slider's σ_p: the steady state of the very model the fused
     # filter ran with (the curve's value at this σ_p), and proprioception's share of
@@ -171,8 +235,10 @@ def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarr
     for gid, values in estimate_lines(truth, vision, fused).items():
         panels.trial.lines[gid].set_ydata(values)
     panels.marker.set_data([sigma_p], [theory_now])
+    whose = ENGINE if filter is None else f"your {student_code.function_name(filter)}"
     return (f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} "
-            f"Proprioception's weight in the steady state: {100 * weight_p:.1f} %.")
+            f"Proprioception's weight in the steady state: {100 * weight_p:.1f} %. "
+            f"Estimates from {whose}.")
 
 
 class _Panels(NamedTuple):
@@ -213,15 +279,21 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     return _Panels(trial, marker)
 
 
-def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFAULT) -> str:
-    """What :func:`draw_noisier_proprioception` shows at ``sigma_p`` (its alt text)."""
+def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFAULT,
+                                    whose: str = ENGINE) -> str:
+    """What :func:`draw_noisier_proprioception` shows at ``sigma_p`` (its alt text).
+
+    ``whose`` names the filter that made the estimates ("your my_filter").
+    """
     return (f"One trial at σ_v = {scenario.sigma_v:g} cm and σ_p = {sigma_p:.1f} cm. Left: "
-            f"true position, the vision-only and the fused estimate, and their errors; right: "
-            f"the fused filter's steady-state position variance against σ_p, with "
+            f"true position, the vision-only and the fused estimate ({whose}), and their "
+            f"errors; right: the fused filter's steady-state position variance against σ_p "
+            f"(the pack's steady state, which does not depend on the readings), with "
             f"σ_p = {sigma_p:.1f} cm marked, below the vision-only level.")
 
 
-def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
+def explore_noisier_proprioception(scenario: Scenario = DEFAULT, *,
+                                   filter: Callable[..., np.ndarray] | None = None) -> Explorer:
     """A σ_p slider over vision-only and fused tracking of one fixed trial.
 
     The unit noise is drawn once from the scenario's explorer seed (another draw than
@@ -229,13 +301,32 @@ def explore_noisier_proprioception(scenario: Scenario = DEFAULT) -> Explorer:
     moving σ_p rescales the same proprioceptive noise pattern; vision's readings and
     the vision-only run never change. The slider starts at :data:`START_SIGMA_P`, near
     question (d)'s σ_p; σ_v is the scenario's.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Constants of the simulation.
+    filter : callable, optional
+        The student's filter (``explore_noisier_proprioception(filter=my_filter)``): the
+        slider then runs it for both estimates (see :func:`draw_noisier_proprioception`)
+        and a failure shows as one line above the last picture. Default the engine.
+
+    Raises
+    ------
+    ValueError
+        If ``filter`` is neither None nor a function.
     """
+    if filter is not None and not callable(filter):
+        raise ValueError(f"filter must be a function such as my_filter, or None for the "
+                         f"pack's engine, got a {type(filter).__name__}")
     low, high, step = SIGMA_P_RANGE
     sliders = {"sigma_p": float_slider("σ_p (cm)", START_SIGMA_P, low, high, step,
                                        readout_format=".1f")}
     noise = unit_noise(with_explorer_seed(scenario))
-    vision_run = LastResults(partial(vision_only, scenario, scenario.sigma_v, noise))
-    draw = partial(_draw, scenario=scenario, noise=noise, vision_run=vision_run)
+    vision_run = LastResults(partial(_vision_run, scenario, noise, filter))
+    draw = partial(_draw, scenario=scenario, noise=noise, vision_run=vision_run, filter=filter)
+    whose = ENGINE if filter is None else f"your {student_code.function_name(filter)}"
     return Explorer("How much does a noisier proprioception help?", sliders, draw,
                     figsize=(10.0, 5.0),
-                    describe=partial(describe_noisier_proprioception, scenario=scenario))
+                    describe=partial(describe_noisier_proprioception, scenario=scenario,
+                                     whose=whose))

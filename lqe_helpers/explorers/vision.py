@@ -2,9 +2,13 @@
 
 One slider sets the vision noise σ_v. The figure shows the true path, the noisy
 visual samples and the filter's estimate with the ±2σ band of its own position
-variance, for one fixed noise pattern scaled by σ_v. The numbers of the view (σ_v
-and this run's MSEs) are returned as one line of text that the explorer shows
-between the slider and the figure.
+variance, for one fixed noise pattern scaled by σ_v. The estimate is the pack's
+engine's, or that of the student's own filter (``explore_vision(filter=my_filter)``),
+run through :func:`lqe_helpers.student_code.call` (copies of its inputs, a time limit;
+a failure is one line in the explorer). The band comes from the engine's covariance
+sequence, which does not depend on the readings, so it is the same for either filter.
+The numbers of the view (σ_v, whose filter, this run's MSEs) are returned as one line
+of text that the explorer shows between the slider and the figure.
 
 Speed: building a matplotlib figure (axes, ticks, legend) costs more than the whole
 filter run, so :func:`draw_vision` builds the panel once per figure
@@ -16,6 +20,7 @@ checks the PNG bytes); only the redraw is faster.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
 
@@ -25,7 +30,7 @@ from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .. import experiments, validation
+from .. import experiments, metrics, student_code, validation
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -36,6 +41,11 @@ from .sliders import float_slider, starting_value
 SIGMA_V_RANGE = (0.1, 10.0)
 #: Slider step for σ_v (cm).
 SIGMA_V_STEP = 0.1
+
+#: Parameter names of a filter the explorer runs: ``filter(y, A, C, Q, R, z0, P0)``.
+FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+#: How the numbers line names the filter that made the estimate.
+ENGINE_NAME = "the pack's engine"
 
 #: Labels of the plotted artists, so tests and readers can find them.
 TRUTH_LABEL = "true position"
@@ -71,7 +81,8 @@ def _build(figure: Figure, scenario: Scenario) -> _Panel:
 
 
 def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
-                noise: np.ndarray | None = None) -> str:
+                noise: np.ndarray | None = None,
+                filter: Callable[..., np.ndarray] | None = None) -> str:
     """Draw one vision-only tracking run at vision noise ``sigma_v`` on ``figure``.
 
     Draws the whole figure: the true position, the noisy visual measurements
@@ -91,32 +102,42 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
         Every other constant (Δt, the flight, Q, z0, P0, burn-in).
     noise : ndarray, shape (n, 1), optional
         Unit noise scaled by σ_v; default the scenario's fixed vision draw.
+    filter : callable, optional
+        A student's ``filter(y, A, C, Q, R, z0, P0)`` returning the estimates (n, 3),
+        e.g. ``my_filter``; it gets the readings (n, 1) and the model of
+        :func:`lqe_helpers.experiments.filter_model`. Default: the pack's engine.
 
     Returns
     -------
     str
-        The numbers of this view, for the line beside the figure: σ_v and this
-        run's mean squared error (cm²) of the raw vision and of the filtered
-        estimate after the scenario's burn-in.
+        The numbers of this view, for the line beside the figure: σ_v, whose filter
+        made the estimate, and this run's mean squared error (cm²) of the raw vision
+        and of the filtered estimate after the scenario's burn-in.
 
     Raises
     ------
     ValueError
         If ``sigma_v`` is not a finite number > 0, or ``noise`` has the wrong shape.
+    lqe_helpers.student_code.StudentCodeError
+        If ``filter`` is not a function, fails, runs too long or returns anything but
+        an (n, 3) array of real numbers (one line, naming the student's own line).
     """
     return _draw(figure, sigma_v=validation.positive("sigma_v", sigma_v, "cm"),
-                 scenario=scenario, noise=noise)
+                 scenario=scenario, noise=noise, filter=filter)
 
 
 def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
-          noise: np.ndarray | None) -> str:
+          noise: np.ndarray | None, filter: Callable[..., np.ndarray] | None = None) -> str:
     """:func:`draw_vision` of a σ_v already checked (by it, or by the slider's range)."""
     tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise)
     measured = tracking.measurements[:, 0]
-    estimate = tracking.positions
+    if filter is None:
+        estimate, whose = tracking.positions, ENGINE_NAME
+    else:
+        estimate, whose = _student_positions(filter, tracking, sigma_v)
     std = np.sqrt(tracking.position_variances)
     raw_mse = float(tracking.measurement_mse("vision"))
-    filtered_mse = float(tracking.mse())
+    filtered_mse = float(metrics.mse(estimate, scenario.truth[:, 0], scenario.burn_in_steps))
 
     panel = reuse_panels(figure, _build, scenario)
     panel.vision.set_ydata(measured)
@@ -127,17 +148,41 @@ def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panel.ax, low - margin, high + margin, scenario.amplitude / 2)
-    return (f"σ_v = {sigma_v:.1f} cm. MSE of this run after {scenario.burn_in:g} s: "
-            f"raw vision {raw_mse:.2f} cm², filtered {filtered_mse:.2f} cm².")
+    return (f"σ_v = {sigma_v:.1f} cm, filtered by {whose}. MSE of this run after "
+            f"{scenario.burn_in:g} s: raw vision {raw_mse:.2f} cm², filtered "
+            f"{filtered_mse:.2f} cm².")
 
 
-def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT) -> str:
+def _student_positions(filter: Callable[..., np.ndarray], tracking: experiments.Tracking,
+                       sigma_v: float) -> tuple[np.ndarray, str]:
+    """Positions (n,) (cm) of a student's filter on the tracking's readings, and its name.
+
+    Raises StudentCodeError (one line) if the filter fails or returns no (n, 3) array.
+    """
+    name = student_code.function_name(filter)
+    model = tracking.model
+    where = f"the explorer's readings at σ_v = {sigma_v:.1f} cm"
+    output = student_code.call(
+        filter, tracking.measurements, model.A, model.C, model.Q, model.R, model.z0, model.P0,
+        name=name, where=where, arg_names=FILTER_ARGS, rerun="run the explorer's cell again")
+    n, k = tracking.result.estimates.shape
+    estimates = student_code.result_array(
+        output, name=name, what=f"the estimates ẑ, an array of shape (n, k) = {(n, k)}",
+        shape=(n, k), where=where)
+    return estimates[:, 0], f"your {name}"
+
+
+def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT,
+                    filter: Callable[..., np.ndarray] | None = None) -> str:
     """One sentence saying what :func:`draw_vision` shows at ``sigma_v`` (its alt text)."""
+    whose = ENGINE_NAME if filter is None else f"your {student_code.function_name(filter)}"
     return (f"Position against time, 0–{scenario.duration:g} s: true path, noisy vision at "
-            f"σ_v = {sigma_v:.1f} cm and the filtered estimate with its ±2σ band.")
+            f"σ_v = {sigma_v:.1f} cm and the estimate of {whose} with a ±2σ band from the "
+            f"engine's covariance sequence, which does not depend on the readings.")
 
 
-def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
+def explore_vision(scenario: Scenario = DEFAULT, *,
+                   filter: Callable[..., np.ndarray] | None = None) -> Explorer:
     """Slider for σ_v (cm) over :func:`draw_vision`, with one fixed noise pattern.
 
     The unit noise is drawn once from the scenario's explorer seed (another draw than
@@ -148,6 +193,10 @@ def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
     ----------
     scenario : Scenario
         Constants of the simulation; the slider starts at its ``sigma_v``.
+    filter : callable, optional
+        The student's ``my_filter(y, A, C, Q, R, z0, P0)``: the slider then runs it, and
+        the numbers line says so. If it fails, the explorer shows its one-line message
+        and tries again on the next move. Default: the pack's engine.
 
     Returns
     -------
@@ -157,15 +206,20 @@ def explore_vision(scenario: Scenario = DEFAULT) -> Explorer:
     Raises
     ------
     ValueError
-        If ``scenario.sigma_v`` lies outside the slider's range :data:`SIGMA_V_RANGE`.
+        If ``scenario.sigma_v`` lies outside the slider's range :data:`SIGMA_V_RANGE`,
+        or ``filter`` is given but is not a function.
     """
     low, high = SIGMA_V_RANGE
     start = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
+    if filter is not None and not callable(filter):
+        raise ValueError(f"filter must be your filter function (e.g. my_filter, without "
+                         f"parentheses) or None for the pack's engine, got a "
+                         f"{type(filter).__name__}")
     noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
     slider = float_slider("σ_v (cm)", start, low, high, SIGMA_V_STEP, readout_format=".1f")
     return Explorer(
         "Vision-only tracking as the vision noise σ_v changes",
         {"sigma_v": slider},
-        partial(_draw, scenario=scenario, noise=noise),
-        describe=partial(describe_vision, scenario=scenario),
+        partial(_draw, scenario=scenario, noise=noise, filter=filter),
+        describe=partial(describe_vision, scenario=scenario, filter=filter),
     )

@@ -26,7 +26,7 @@ from .bias import (
 )
 from .common import paired_mse_figure, tracking_comparison_figure
 from .delay import delay_figure, delay_sweep_figure, prediction_error_sources_figure
-from .fusion import fusion_trial_figure
+from .fusion import frequency_response_figure, fusion_trial_figure
 from .initial_covariance import (
     belief_and_error_figure,
     gains_figure,
@@ -35,14 +35,33 @@ from .initial_covariance import (
     start_up_figure,
 )
 from .noisier_proprioception import assumed_noise_figure, proprioception_sweep_figure
-from .vision import estimate_error_figure
+from .vision import estimate_error_figure, lag_figure
 
 __all__ = [
-    "acceleration_signal_figure", "assumed_noise_figure", "belief_and_error_figure",
-    "bias_learning_figure", "bias_settling_figure", "delay_figure", "delay_sweep_figure",
-    "drift_figure", "estimate_error_figure", "fusion_trial_figure", "gains_figure",
-    "jerk_sweep_figure", "mse_intervals_figure", "noise_sweep_figure", "open_loop_figure",
-    "p0_sweep_figure", "paired_mse_figure", "prediction_error_sources_figure",
-    "proprioception_sweep_figure", "squared_error_figure", "start_up_figure",
-    "tracking_comparison_figure", "tracking_panels_figure", "uncertainty_growth_figure",
+    "acceleration_signal_figure",
+    "assumed_noise_figure",
+    "belief_and_error_figure",
+    "bias_learning_figure",
+    "bias_settling_figure",
+    "delay_figure",
+    "delay_sweep_figure",
+    "drift_figure",
+    "estimate_error_figure",
+    "frequency_response_figure",
+    "fusion_trial_figure",
+    "gains_figure",
+    "jerk_sweep_figure",
+    "lag_figure",
+    "mse_intervals_figure",
+    "noise_sweep_figure",
+    "open_loop_figure",
+    "p0_sweep_figure",
+    "paired_mse_figure",
+    "prediction_error_sources_figure",
+    "proprioception_sweep_figure",
+    "squared_error_figure",
+    "start_up_figure",
+    "tracking_comparison_figure",
+    "tracking_panels_figure",
+    "uncertainty_growth_figure",
 ]

@@ -1,4 +1,5 @@
-"""Figures of notebook 03 (fusion): one trial of vision alone against vision + proprioception.
+"""Figures of notebook 03 (fusion): one trial of vision alone against vision + proprioception,
+and the settled filters' frequency response (Going further).
 
 Notebook 04 draws the same comparison with a noisier proprioception. Both notebooks'
 Monte Carlo comparisons use the shared :func:`~lqe_helpers.figures.common.paired_mse_figure`.
@@ -6,10 +7,14 @@ Monte Carlo comparisons use the shared :func:`~lqe_helpers.figures.common.paired
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
+import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from .common import tracking_comparison_figure
+from ..plotting import COLORS, style
+from .common import label_axes, mark_values, plain_log_ticks, tracking_comparison_figure
 
 
 def fusion_trial_figure(times: np.ndarray, truth: np.ndarray, vision_only: np.ndarray,
@@ -55,3 +60,83 @@ def fusion_trial_figure(times: np.ndarray, truth: np.ndarray, vision_only: np.nd
                  "proprioception readings": (readings[:, 1], "proprioception")}
     estimates = {"vision only": (vision_only, "alternative"), fused_label: (fused, "estimate")}
     return tracking_comparison_figure(times, truth, estimates, readings=shown, title=title)
+
+
+#: A curve of :func:`frequency_response_figure`: (gain |H|, shape (f,); lead in s, shape
+#: (f,); style role).
+ResponseCurve = tuple[np.ndarray, np.ndarray, str]
+#: A simulated point of :func:`frequency_response_figure`: (gain, lead in s, style role).
+ResponsePoint = tuple[float, float, str]
+
+
+def frequency_response_figure(frequency: np.ndarray, curves: Mapping[str, ResponseCurve], *,
+                              marked: float,
+                              points: Mapping[str, ResponsePoint] | None = None,
+                              title: str = "") -> Figure:
+    """The settled filters' frequency response: gain (top) and lead (bottom) against f.
+
+    A true position ``sin(2π f t)`` read without noise comes out of a settled filter as
+    ``|H| sin(2π f (t + lead))``. Each curve is one filter (from
+    :func:`lqe_helpers.lowpass.position_response`); each point a simulated run at
+    ``marked`` (a sinusoid fitted to a noise-free estimate), to set beside its curve.
+
+    Parameters
+    ----------
+    frequency : array_like, shape (f,)
+        Frequencies (Hz), > 0, drawn on a log axis.
+    curves : mapping of str to (gain, lead, role)
+        Legend label → gain ``|H|`` (unitless) and lead (s, > 0 ahead of the movement),
+        each of shape (f,), drawn in the role's style (e.g. ``"alternative"`` for vision
+        alone, ``"estimate"`` for the fused filter).
+    marked : float
+        The flight's frequency (Hz), marked by a vertical line in both panels.
+    points : mapping of str to (gain, lead, role), optional
+        Legend label → a simulated gain and lead (s) at ``marked``, drawn as a circle in
+        the role's colour.
+    title : str
+        Title of the top panel.
+
+    Returns
+    -------
+    Figure
+        Two panels sharing the frequency axis; in each the curves, then the points.
+
+    Raises
+    ------
+    ValueError
+        If ``frequency`` is not positive and of shape (f,), a curve does not match it,
+        or ``marked`` is not > 0.
+    """
+    frequency = np.asarray(frequency, dtype=float)
+    if frequency.ndim != 1 or frequency.size < 2 or np.any(frequency <= 0):
+        raise ValueError(f"frequency must be frequencies > 0 Hz of shape (f,), f >= 2, got "
+                         f"shape {frequency.shape}")
+    if not marked > 0:
+        raise ValueError(f"marked must be a frequency > 0 Hz, got {marked}")
+    fig, (ax_gain, ax_lead) = plt.subplots(2, 1, figsize=(8.5, 6.0), sharex=True)
+    ax_gain.axhline(1.0, **style("truth", linewidth=0.8, label="|H| = 1: passed unchanged"))
+    ax_lead.axhline(0.0, **style("truth", linewidth=0.8))
+    for label, (gain, lead, role) in curves.items():
+        gain, lead = np.asarray(gain, dtype=float), np.asarray(lead, dtype=float)
+        if gain.shape != frequency.shape or lead.shape != frequency.shape:
+            raise ValueError(f"curve {label!r} must have gain and lead of shape "
+                             f"{frequency.shape}, got {gain.shape} and {lead.shape}")
+        ax_gain.plot(frequency, gain, **style(role, label=label))
+        ax_lead.plot(frequency, 1000 * lead, **style(role, label=label))
+    for label, (gain, lead, role) in (points or {}).items():
+        marker = {"color": COLORS[role], "linestyle": "none", "marker": "o", "markersize": 7,
+                  "markerfacecolor": "none", "markeredgewidth": 1.6}
+        ax_gain.plot([marked], [gain], label=label, **marker)
+        ax_lead.plot([marked], [1000 * lead], label=label, **marker)
+    mark_values(ax_gain, {f"{marked:g} Hz": marked}, COLORS["reference"], linestyle=":",
+                linewidth=1.2)
+    ax_lead.axvline(marked, color=COLORS["reference"], linestyle=":", linewidth=1.2)
+    label_axes(ax_gain, ylabel="gain |H| (estimate / movement)", title=title,
+               xscale="log", legend={"loc": "lower left", "fontsize": 8})
+    label_axes(ax_lead, "frequency of the movement (Hz)", "lead (ms), > 0 = ahead",
+               xlim=(frequency[0], frequency[-1]))
+    plain_log_ticks(ax_lead, "x", [tick for tick in (0.01, 0.02, 0.05, 0.1, 0.2, 0.5, 1, 2,
+                                                     5, 10, 20, 50)
+                                   if frequency[0] <= tick <= frequency[-1]])
+    fig.tight_layout()
+    return fig

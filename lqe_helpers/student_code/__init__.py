@@ -15,6 +15,7 @@ everywhere; :func:`save` and :func:`load` carry a function from one notebook to 
 
 from .calling import NOT_WRITTEN_ADVICE, TIME_LIMIT, call, function_name
 from .errors import (
+    NotSavedYet,
     NotWrittenYet,
     OwnCodeTraceback,
     StudentCodeError,
@@ -32,6 +33,7 @@ __all__ = [
     "SAVE_FOLDER",
     "SAVE_HEADER",
     "TIME_LIMIT",
+    "NotSavedYet",
     "NotWrittenYet",
     "OwnCodeTraceback",
     "StudentCodeError",

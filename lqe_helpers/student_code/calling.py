@@ -139,13 +139,62 @@ def _stop_thread(worker: threading.Thread, kind: type[BaseException]) -> None:
         pass
 
 
+class _Tripped(BaseException):
+    """Raised inside a student's function when it runs a forbidden function of the pack."""
+
+
+class _Watch:
+    """Notices whether a student's function runs any of the ``forbid`` functions.
+
+    A profile hook (``sys.setprofile``, in the thread that runs the student's code) sees
+    every Python function call; entering a forbidden function's code records its name and
+    raises :class:`_Tripped`, which ``except Exception`` cannot swallow. The record stands
+    even if a bare ``except:`` swallows that exception too.
+    """
+
+    def __init__(self, forbid: Sequence[Callable]) -> None:
+        self.codes = {}
+        for function in forbid:
+            code = getattr(inspect.unwrap(function), "__code__", None)
+            if code is None:
+                raise ValueError(f"forbid must hold Python functions, got {function!r}")
+            self.codes[code] = f"{function.__module__}.{function.__qualname__}"
+        self.tripped = ""
+
+    def wrap(self, function: Callable) -> Callable:
+        if not self.codes:
+            return function
+
+        def watched(*args: object) -> object:
+            previous = sys.getprofile()
+
+            def profile(frame: types.FrameType, event: str, arg: object) -> None:
+                if previous is not None:
+                    previous(frame, event, arg)
+                if event == "call" and frame.f_code in self.codes:
+                    self.tripped = self.tripped or self.codes[frame.f_code]
+                    raise _Tripped
+
+            sys.setprofile(profile)
+            try:
+                return function(*args)
+            except _Tripped:
+                return None
+            finally:
+                sys.setprofile(previous)
+
+        watched.__name__ = getattr(function, "__name__", "watched")
+        return watched
+
+
 def _copy(value: object) -> object:
     return value.copy() if isinstance(value, np.ndarray) else value
 
 
 def call(function: Callable, *args: object, name: str | None = None, where: str = "",
          time_limit: float | None = None, arg_names: Sequence[str] | None = None,
-         hint: str = "", shape_hint: str = "", rerun: str = "run this check again") -> object:
+         hint: str = "", shape_hint: str = "", rerun: str = "run this check again",
+         forbid: Sequence[Callable] = ()) -> object:
     """Call a student's function on copies of ``args`` under a time limit.
 
     Array arguments are copied, so the student's function cannot change the caller's
@@ -182,6 +231,10 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         Added to the message of any error, and of an error about shapes.
     rerun : str
         The last step of the "not written yet" advice.
+    forbid : sequence of callables
+        Functions of the pack that hold the task's answer (the engine's eq. (5), say).
+        If the student's function runs one of them, directly or through anything it
+        calls, the call fails: the task is to write it, not to call the pack's.
 
     Returns
     -------
@@ -196,7 +249,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         If ``function`` is not callable, raised any other exception (including
         ``SystemExit`` and ``KeyboardInterrupt``), did not return within the limit,
         changed an input in place (with ``arg_names``), replaced a function of the pack
-        or of numpy (restored first), or is an ``async`` function. One line: the type,
+        or of numpy (restored first), ran a function of ``forbid``, or is an ``async``
+        function. One line: the type,
         message and the line of the student's own code where it happened.
     """
     name = name or function_name(function)
@@ -212,8 +266,14 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     before = _snapshot()
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     run = _run_with_alarm if alarm else _run_in_thread
-    kind, value = run(function, copies, float(time_limit))
+    watch = _Watch(forbid)
+    kind, value = run(watch.wrap(function), copies, float(time_limit))
     replaced = _restore(before)
+    if watch.tripped:
+        raise StudentCodeError(
+            f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "
+            f"yourself, from the equation, with NumPy (@, np.linalg), not to call the pack's "
+            f"solution")
     if kind == "timeout":
         error = value if isinstance(value, BaseException) else None
         failure = TimedOut(
@@ -249,6 +309,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
 def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] | None,
             hint: str, shape_hint: str, rerun: str) -> StudentCodeError:
     """The StudentCodeError reporting ``error``, raised by the student's function."""
+    if isinstance(error, StudentCodeError):  # already one line for the student (a stand-in's)
+        return error
     if isinstance(error, NotImplementedError):
         return NotWrittenYet(
             f"{name} is not written yet: {NOT_WRITTEN_ADVICE.format(rerun=rerun)}")

@@ -62,6 +62,10 @@ class TimedOut(StudentCodeError):
     """The student's function did not return within its time limit (and was stopped)."""
 
 
+class NotSavedYet(StudentCodeError):
+    """A function another notebook saves (``my_functions/<name>.py``) is not saved yet."""
+
+
 def _ipython_shell():
     module = sys.modules.get("IPython")
     return module.get_ipython() if module is not None else None

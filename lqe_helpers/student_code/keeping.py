@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from .calling import call, function_name
-from .errors import StudentCodeError, error_text, short_repr
+from .errors import NotSavedYet, StudentCodeError, error_text, short_repr
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -182,13 +182,16 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     Returns
     -------
     callable
-        The function.
+        The function. If its file does not exist yet, a stand-in of the same name that
+        raises :class:`NotSavedYet` (one line naming the notebook whose task writes it)
+        whenever it is called, so the rest of the notebook (an explorer, say) still runs
+        and every use of the function says what to do; :func:`load` then prints that
+        line once too.
 
     Raises
     ------
     StudentCodeError
-        One line: the file does not exist (naming the notebook whose task writes it),
-        cannot be read or run, or does not define ``name``.
+        One line: the file cannot be read or run, or does not define ``name``.
     """
     if not isinstance(name, str) or not name.isidentifier():
         raise ValueError(f"name must be a function's name, e.g. 'my_filter', got {name!r}")
@@ -196,8 +199,10 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     shown = _shown(path)
     if not path.is_file():
         writer = SAVED_BY.get(name, f"the notebook whose task defines {name}")
-        raise StudentCodeError(f"{shown} does not exist yet: {writer} writes it when its "
-                               f"check passes; run that first")
+        message = (f"{name} is not saved yet: {shown} does not exist. {writer} writes it when "
+                   f"its check passes; run that first, then run this notebook again")
+        print(message)
+        return _not_saved_yet(name, message)
     try:
         source = path.read_text("utf-8")
         code = compile(source, str(path), "exec")
@@ -212,3 +217,13 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     if not isinstance(function, types.FunctionType):
         raise StudentCodeError(f"{shown} does not define a function {name}")
     return function
+
+
+def _not_saved_yet(name: str, message: str) -> Callable:
+    """A stand-in for the function ``name`` that says it is not saved yet when called."""
+
+    def stand_in(*args: object, **kwargs: object) -> object:
+        raise NotSavedYet(message)
+
+    stand_in.__name__ = stand_in.__qualname__ = name
+    return stand_in
