@@ -1,4 +1,4 @@
-"""The P0 explorer of question (b) draws exactly what the engine computes."""
+"""The P0 explorer of question (b) draws what the engine, or the student's filter, computes."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 from lqe_helpers import experiments, metrics
 from lqe_helpers.explorers import initial_covariance as ic
 from lqe_helpers.scenario import DEFAULT
+from lqe_helpers.student_code import calling
 
 SHOWN = round(ic.WINDOW / DEFAULT.dt) + 1
 
@@ -64,9 +65,9 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance)
     burn = DEFAULT.burn_in_steps
     early = metrics.mse(expected.positions[:burn], truth[:burn, 0])
     late = metrics.mse(expected.positions, truth[:, 0], burn)
-    assert explorer.numbers == (f"P0 = {p0_variance:.3g} · I. Position MSE of this run: "
-                                f"{early:.2f} cm² in the first {DEFAULT.burn_in:g} s, "
-                                f"{late:.2f} cm² after.")
+    assert explorer.numbers == (f"The pack's engine, P0 = {p0_variance:.3g} · I. Position MSE "
+                                f"of this run: {early:.2f} cm² in the first "
+                                f"{DEFAULT.burn_in:g} s, {late:.2f} cm² after.")
     assert explorer.figure.get_suptitle() == ""
 
 
@@ -131,7 +132,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     bundle = explorer._repr_mimebundle_()
     assert "P0 (cm²)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
-    assert explorer.numbers.startswith(f"P0 = {DEFAULT.p0_variance:.3g} · I. ")
+    assert explorer.numbers.startswith(f"The pack's engine, P0 = {DEFAULT.p0_variance:.3g} · I. ")
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
@@ -154,7 +155,7 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     figure.clear()
     numbers = ic.draw_initial_covariance(figure, p0_variance=1e3)
     assert len(figure.axes) == 2
-    assert numbers.startswith("P0 = 1e+03 · I. ")
+    assert numbers.startswith("The pack's engine, P0 = 1e+03 · I. ")
 
 
 def test_slider_starts_at_the_scenarios_p0_variance() -> None:
@@ -169,3 +170,107 @@ def test_scenario_outside_the_slider_range_is_refused(p0_variance: float) -> Non
     scenario = dataclasses.replace(DEFAULT, p0_variance=p0_variance)
     with pytest.raises(ValueError, match=r"scenario\.p0_variance .*\[0\.01, 1000000\] cm²"):
         ic.explore_initial_covariance(scenario)
+
+
+# ------------------------------------------------------------------------------------------
+# The student's own filter drives the explorer
+# ------------------------------------------------------------------------------------------
+
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    """A correct student's filter. (This file ships to students, so it wraps the engine
+    rather than spell out eq. (5), notebook 01's task.)"""
+    return experiments.FilterModel(A, C, Q, R, z0, P0).filter(y).estimates
+
+
+def shifted_filter(y, A, C, Q, R, z0, P0):
+    """A student's filter whose positions are 0.5 cm too high: what it returns is drawn."""
+    return my_filter(y, A, C, Q, R, z0, P0) + np.array([0.5, 0.0, 0.0])
+
+
+def test_the_students_filter_draws_what_the_engine_computes() -> None:
+    """Estimates equal to the engine's (1e-9), bands from the engine, numbers say whose."""
+    ours, theirs = Figure(), Figure()
+    for p0_variance in (1e-2, 1.0, 1e5, 1e6):
+        mine = ic.draw_initial_covariance(ours, p0_variance=p0_variance, filter=my_filter)
+        engine = ic.draw_initial_covariance(theirs, p0_variance=p0_variance)
+        assert mine.startswith(f"Your my_filter, P0 = {p0_variance:.3g} · I. ")
+        assert mine.removeprefix("Your my_filter") == engine.removeprefix("The pack's engine")
+        for column in (0, 1):
+            np.testing.assert_allclose(line(ours.axes[column], ic.ESTIMATE_LABEL),
+                                       line(theirs.axes[column], ic.ESTIMATE_LABEL),
+                                       rtol=1e-9, atol=1e-9)
+            bands = [[path.vertices for path in ax.collections[0].get_paths()]
+                     for ax in (ours.axes[column], theirs.axes[column])]
+            np.testing.assert_allclose(bands[0][0], bands[1][0], rtol=1e-9, atol=1e-9)
+
+
+def test_the_explorer_draws_what_the_students_filter_returns() -> None:
+    """The estimate and its MSEs come from the student's function, the band from the engine."""
+    shifted, engine = Figure(), Figure()
+    numbers = ic.draw_initial_covariance(shifted, p0_variance=1.0, filter=shifted_filter)
+    ic.draw_initial_covariance(engine, p0_variance=1.0)
+    np.testing.assert_allclose(line(shifted.axes[0], ic.ESTIMATE_LABEL),
+                               line(engine.axes[0], ic.ESTIMATE_LABEL) + 0.5, atol=1e-9)
+    positions = experiments.track(DEFAULT, p0_variance=1.0).positions + 0.5  # draw's default
+    late = metrics.mse(positions, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
+    assert numbers.startswith("Your shifted_filter, P0 = 1 · I. ")
+    assert numbers.endswith(f"{late:.2f} cm² after.")
+
+
+def test_an_explorer_of_the_students_filter_says_whose_it_is() -> None:
+    explorer = ic.explore_initial_covariance(filter=my_filter)
+    assert explorer.problem == ""
+    assert explorer.numbers.startswith("Your my_filter, P0 = 1 · I. ")
+    assert "by your my_filter" in explorer.description
+    assert "do not depend on the readings" in explorer.description
+    explorer.sliders["p0_variance"].value = 1e5
+    assert explorer.numbers.startswith("Your my_filter, P0 = 1e+05 · I. ")
+
+
+def broken_filter(y, A, C, Q, R, z0, P0):
+    """A student's filter with a slip: a matrix product that does not fit."""
+    return A @ y
+
+
+def not_written_filter(y, A, C, Q, R, z0, P0):
+    raise NotImplementedError
+
+
+def wrong_shape_filter(y, A, C, Q, R, z0, P0):
+    """Returns the positions only."""
+    return my_filter(y, A, C, Q, R, z0, P0)[:, 0]
+
+
+@pytest.mark.parametrize(("function", "phrase"), [
+    (broken_filter, "broken_filter raised ValueError"),
+    (not_written_filter, "not_written_filter is not written yet"),
+    (wrong_shape_filter, "wrong_shape_filter returned an array of shape (1000,)"),
+])
+def test_a_broken_students_filter_is_one_line_and_the_next_move_tries_again(function,
+                                                                           phrase) -> None:
+    explorer = ic.explore_initial_covariance(filter=function)
+    assert phrase in explorer.problem, explorer.problem
+    assert explorer.numbers == explorer.problem and "\n" not in explorer.problem
+    assert explorer.png.startswith(b"\x89PNG")            # a picture all the same
+    explorer.sliders["p0_variance"].value = 1e3           # the next move tries again
+    assert phrase in explorer.problem
+
+
+def test_a_students_filter_that_hangs_is_stopped(monkeypatch) -> None:
+    monkeypatch.setattr(calling, "TIME_LIMIT", 0.2)
+
+    def hanging_filter(y, A, C, Q, R, z0, P0):
+        while True:
+            pass
+
+    explorer = ic.explore_initial_covariance(filter=hanging_filter)
+    assert "hanging_filter" in explorer.problem and "0.2 s" in explorer.problem
+
+
+@pytest.mark.parametrize("bad", ["my_filter", 3.0, [my_filter]])
+def test_a_filter_that_is_not_a_function_is_refused_by_name(bad) -> None:
+    with pytest.raises(ValueError, match=r"filter must be None .* or a function"):
+        ic.explore_initial_covariance(filter=bad)
+    with pytest.raises(ValueError, match="filter must be None"):
+        ic.draw_initial_covariance(Figure(), p0_variance=1.0, filter=bad)

@@ -17,10 +17,11 @@ One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exp
 every ``check_…`` and the tolerances:
 
 - ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
-  ``vision_further`` for its Going further), ``initial_covariance`` (02), ``fusion``
-  (03, with ``fusion_further``), ``noisier_proprioception`` (04, with
-  ``misjudged_noise``), ``delay`` (05, with ``compensation_cases``; its Going further in
-  ``delay_sweep`` and ``delay_further``), ``bias`` (06);
+  ``vision_further`` for its Going further), ``initial_covariance`` (02, with
+  ``initial_covariance_further``), ``fusion`` (03, with ``fusion_further``),
+  ``noisier_proprioception`` (04, with ``misjudged_noise``), ``delay`` (05, with
+  ``compensation_cases``; its Going further in ``delay_sweep`` and ``delay_further``),
+  ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -48,7 +49,21 @@ from .fusion_further import (
     check_settled_filter,
     check_settled_variances,
 )
-from .initial_covariance import check_convergence_time, check_initial_covariance
+from .initial_covariance import (
+    check_convergence_times,
+    check_initial_covariance,
+    check_initial_covariances,
+    check_start_and_after,
+    check_start_of_trial,
+)
+from .initial_covariance_further import (
+    BOOTSTRAP_ATOL,
+    check_convergence_intervals,
+    check_first_gains,
+    check_flight_scales,
+    check_overconfidence,
+    check_p0_sweep,
+)
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -77,6 +92,7 @@ from .vision_further import (
 from .vision_smoothers import check_smoother, check_smoother_comparison
 
 __all__ = [
+    "BOOTSTRAP_ATOL",
     "FUNCTION_RTOL",
     "INTERVAL_RTOL",
     "MATRIX_RTOL",
@@ -89,7 +105,8 @@ __all__ = [
     "check_bias_model",
     "check_compensation",
     "check_compensation_regimes",
-    "check_convergence_time",
+    "check_convergence_intervals",
+    "check_convergence_times",
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
@@ -97,12 +114,15 @@ __all__ = [
     "check_equivalent_sensor",
     "check_error_sources",
     "check_filter",
+    "check_first_gains",
+    "check_flight_scales",
     "check_fusion",
     "check_fusion_difference",
     "check_fusion_trial",
     "check_gain_shares",
     "check_halving",
     "check_initial_covariance",
+    "check_initial_covariances",
     "check_late_eye",
     "check_misjudged",
     "check_misjudged_nis",
@@ -112,6 +132,8 @@ __all__ = [
     "check_noisier_difference",
     "check_noisier_theory",
     "check_noisier_trial",
+    "check_overconfidence",
+    "check_p0_sweep",
     "check_paired_difference",
     "check_prediction_theory",
     "check_proprioception_sweep",
@@ -121,6 +143,8 @@ __all__ = [
     "check_short_delays",
     "check_smoother",
     "check_smoother_comparison",
+    "check_start_and_after",
+    "check_start_of_trial",
     "check_steady_state",
     "check_sweep_reading",
     "check_systematic_error",

@@ -33,7 +33,7 @@ MSE_RTOL = 1e-6
 #: Relative tolerance of :func:`check_initial_covariance` and :func:`check_fusion`.
 MATRIX_RTOL = 1e-9
 
-#: Tolerance (s) of :func:`check_convergence_time`: the time is a whole number of samples.
+#: Tolerance (s) of the convergence-time checks of notebook 02: a time is a whole number of samples.
 TIME_ATOL = 1e-9
 
 #: Relative tolerance (of the interval's scale: its mean or half-width, whichever is

@@ -4,9 +4,15 @@ One logarithmic slider sets P0 = p0_variance · I. The figure shows the first
 seconds of one run: position (truth, noisy vision, estimate) and velocity (truth,
 estimate), each estimate with the ±2σ band of the filter's own variance, so the
 reader sees both how fast the wrong initial guess is corrected and how confident
-the filter is while it is still wrong. The numbers of the view (P0 and this run's
-position MSEs) are returned as one line of text that the explorer shows between the
-slider and the figure.
+the filter is while it is still wrong. The numbers of the view (whose filter, P0 and
+this run's position MSEs) are returned as one line of text that the explorer shows
+between the slider and the figure.
+
+The estimates come from the pack's engine, or from the student's own filter (notebook
+01's ``my_filter``) when one is given: it is then called through
+:func:`lqe_helpers.student_code.call` on every move, and a failure is one line in the
+explorer. The bands always come from the engine's covariance sequence, which does not
+depend on the readings (a student's filter returns estimates only).
 
 Speed: as in :mod:`lqe_helpers.explorers.vision`, the panels are built once per
 figure and later calls replace the data and limits of the same artists; the numbers
@@ -16,6 +22,7 @@ picture equals a fresh drawing.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
 
@@ -26,7 +33,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from .. import experiments, metrics, validation
+from .. import experiments, metrics, student_code, validation
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -47,6 +54,11 @@ TRUTH_LABEL = "truth"
 VISION_LABEL = "noisy vision"
 ESTIMATE_LABEL = "filtered estimate"
 BAND_LABEL = "±2σ of the filter's own variance"
+
+#: The parameters of a filter function (notebook 01's ``my_filter``), in order.
+FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+#: What the numbers line calls the engine.
+ENGINE_NAME = "the pack's engine"
 
 
 def shown_steps(scenario: Scenario) -> int:
@@ -91,17 +103,18 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
 
 
 def draw_initial_covariance(figure: Figure, *, p0_variance: float,
-                            scenario: Scenario = DEFAULT,
-                            noise: np.ndarray | None = None) -> str:
+                            scenario: Scenario = DEFAULT, noise: np.ndarray | None = None,
+                            filter: Callable[..., np.ndarray] | None = None) -> str:
     """Draw the first :data:`WINDOW` seconds of one vision-only run with P0 = p0_variance · I.
 
     Draws the whole figure, two panels side by side. Left: true position, noisy
     vision and the estimated position. Right: true and estimated velocity. Each
     estimate carries a band of ±2 standard deviations of the filter's own variance
-    (Tutorial eq. (5)). The velocity axis is fixed to twice the butterfly's top
-    speed, so a huge initial band or an overshooting estimate runs off the panel
-    instead of rescaling it. A figure not drawn by this function is cleared first;
-    on one it drew before, the same artists receive the new data.
+    (Tutorial eq. (5)), from the engine's covariance sequence (it does not depend on
+    the readings). The velocity axis is fixed to twice the butterfly's top speed, so
+    a huge initial band or an overshooting estimate runs off the panel instead of
+    rescaling it. A figure not drawn by this function is cleared first; on one it drew
+    before, the same artists receive the new data.
 
     Parameters
     ----------
@@ -114,32 +127,70 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
         Every other constant; vision noise is ``scenario.sigma_v``.
     noise : ndarray, shape (n, 1), optional
         Unit vision noise; default the scenario's fixed draw.
+    filter : callable, optional
+        A student's filter ``filter(y, A, C, Q, R, z0, P0) -> estimates (n, 3)``
+        (notebook 01's ``my_filter``), called through
+        :func:`lqe_helpers.student_code.call`; default the pack's engine.
 
     Returns
     -------
     str
-        The numbers of this view, for the line beside the figure: P0 and this
-        run's position MSE (cm²) before and after the scenario's burn-in.
+        The numbers of this view, for the line beside the figure: whose filter, P0 and
+        this run's position MSE (cm²) before and after the scenario's burn-in.
 
     Raises
     ------
     ValueError
-        If ``p0_variance`` is not a finite number > 0, or ``noise`` has the wrong shape.
+        If ``p0_variance`` is not a finite number > 0, ``noise`` has the wrong shape, or
+        ``filter`` is neither None nor a function.
+    lqe_helpers.student_code.StudentCodeError
+        One line, if the student's filter fails or returns something other than the
+        estimates.
     """
     return _draw(figure, p0_variance=validation.positive("p0_variance", p0_variance, "cm²"),
-                 scenario=scenario, noise=noise)
+                 scenario=scenario, noise=noise, filter=_checked_filter(filter))
+
+
+def _checked_filter(filter: object) -> Callable[..., np.ndarray] | None:
+    """``filter`` if it is None or callable, else ValueError naming it."""
+    if filter is not None and not callable(filter):
+        raise ValueError(f"filter must be None (the pack's engine) or a function such as "
+                         f"my_filter, got {type(filter).__name__}")
+    return filter
+
+
+def whose(filter: Callable[..., np.ndarray] | None) -> str:
+    """Whose filter the view shows: "your my_filter", or "the pack's engine"."""
+    return ENGINE_NAME if filter is None else f"your {student_code.function_name(filter)}"
+
+
+def _student_estimates(filter: Callable[..., np.ndarray],
+                       tracking: experiments.Tracking) -> np.ndarray:
+    """The student's filter run on ``tracking``'s readings with its model: (n, 3) estimates."""
+    model = tracking.model
+    name = student_code.function_name(filter)
+    where = f"the explorer's trial with P0 = {float(model.P0[0, 0]):.3g} · I"
+    value = student_code.call(filter, tracking.measurements, model.A, model.C, model.Q,
+                              model.R, model.z0, model.P0, name=name, where=where,
+                              arg_names=FILTER_ARGS, rerun="move the slider again")
+    return student_code.result_array(value, name=name, where=where,
+                                     what="the estimates ẑ, an array of shape (n, 3)",
+                                     shape=tracking.result.estimates.shape)
 
 
 def _draw(figure: Figure, *, p0_variance: float, scenario: Scenario,
-          noise: np.ndarray | None) -> str:
-    """:func:`draw_initial_covariance` of a P0 already checked (by it, or by the slider)."""
+          noise: np.ndarray | None, filter: Callable[..., np.ndarray] | None = None) -> str:
+    """:func:`draw_initial_covariance` of inputs already checked (by it, or by the slider)."""
     tracking = experiments.track(scenario, ("vision",), p0_variance=p0_variance, noise=noise)
+    estimates = (tracking.result.estimates if filter is None
+                 else _student_estimates(filter, tracking))
+    positions, truth = estimates[:, 0], scenario.truth[:, 0]
     burn_in = scenario.burn_in_steps
-    early_mse = float(metrics.mse(tracking.positions[:burn_in], scenario.truth[:burn_in, 0]))
-    late_mse = float(tracking.mse())
+    early_mse = float(metrics.mse(positions[:burn_in], truth[:burn_in]))
+    late_mse = float(metrics.mse(positions, truth, burn_in))
     shown = shown_steps(scenario)
     measured = tracking.measurements[:shown, 0]
-    estimates = tracking.result.estimates[:shown]
+    estimates = estimates[:shown]
     variances = tracking.result.estimate_covariances[:shown]
 
     panels = reuse_panels(figure, _build, scenario)
@@ -154,19 +205,24 @@ def _draw(figure: Figure, *, p0_variance: float, scenario: Scenario,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panels.axes[0], low - margin, high + margin, scenario.amplitude / 2)
-    return (f"P0 = {p0_variance:.3g} · I. Position MSE of this run: {early_mse:.2f} cm² in "
-            f"the first {scenario.burn_in:g} s, {late_mse:.2f} cm² after.")
+    who = whose(filter)
+    return (f"{who[0].upper()}{who[1:]}, P0 = {p0_variance:.3g} · I. Position MSE of this "
+            f"run: {early_mse:.2f} cm² in the first {scenario.burn_in:g} s, {late_mse:.2f} "
+            f"cm² after.")
 
 
-def describe_initial_covariance(*, p0_variance: float, scenario: Scenario = DEFAULT) -> str:
+def describe_initial_covariance(*, p0_variance: float, scenario: Scenario = DEFAULT,
+                                filter: Callable[..., np.ndarray] | None = None) -> str:
     """What :func:`draw_initial_covariance` shows at ``p0_variance`` (its alt text)."""
     seconds = (shown_steps(scenario) - 1) * scenario.dt
-    return (f"The first {seconds:g} s of vision-only tracking with P0 = {p0_variance:.3g} · I. "
-            f"Left: true position, noisy vision and the estimate with its ±2σ band; right: "
-            f"true and estimated velocity with its ±2σ band.")
+    return (f"The first {seconds:g} s of vision-only tracking by {whose(filter)} with P0 = "
+            f"{p0_variance:.3g} · I. Left: true position, noisy vision and the estimate with "
+            f"its ±2σ band; right: true and estimated velocity with its ±2σ band. The bands "
+            f"are the engine's covariances, which do not depend on the readings.")
 
 
-def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
+def explore_initial_covariance(scenario: Scenario = DEFAULT,
+                               filter: Callable[..., np.ndarray] | None = None) -> Explorer:
     """Logarithmic slider for P0 (cm²) over :func:`draw_initial_covariance`.
 
     The unit noise is drawn once from the scenario's explorer seed (another draw than
@@ -177,6 +233,11 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     ----------
     scenario : Scenario
         Constants of the simulation; the slider starts at its ``p0_variance``.
+    filter : callable, optional
+        The student's filter ``filter(y, A, C, Q, R, z0, P0)`` (notebook 01's
+        ``my_filter``): the slider then runs it, and the numbers line says so. If it
+        fails, the explorer shows its one-line message and keeps the last picture.
+        Default: the pack's engine.
 
     Returns
     -------
@@ -186,8 +247,10 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     Raises
     ------
     ValueError
-        If ``scenario.p0_variance`` lies outside the slider's range :data:`P0_RANGE`.
+        If ``scenario.p0_variance`` lies outside the slider's range :data:`P0_RANGE`, or
+        ``filter`` is neither None nor a function.
     """
+    filter = _checked_filter(filter)
     low, high = P0_RANGE
     start = starting_value("p0_variance", scenario.p0_variance, low, high, "cm²")
     noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
@@ -196,6 +259,6 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT) -> Explorer:
     return Explorer(
         "The start of vision-only tracking as the initial covariance P0 changes",
         {"p0_variance": slider},
-        partial(_draw, scenario=scenario, noise=noise),
-        describe=partial(describe_initial_covariance, scenario=scenario),
+        partial(_draw, scenario=scenario, noise=noise, filter=filter),
+        describe=partial(describe_initial_covariance, scenario=scenario, filter=filter),
     )
