@@ -14,7 +14,7 @@ from lqe_helpers import experiments, metrics
 from lqe_helpers.explorers import vision
 from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT
-from lqe_helpers.student_code import calling
+from lqe_helpers.student_code import StudentCodeError, calling
 
 
 @pytest.fixture
@@ -244,7 +244,7 @@ def test_a_filter_not_written_yet_says_so() -> None:
 
     explorer = vision.explore_vision(filter=my_filter)
     assert explorer.problem.startswith("my_filter is not written yet: replace the line")
-    assert explorer.problem.endswith("run the explorer's cell again")
+    assert explorer.problem.endswith("then run the Explore cell again")
     assert explorer.png.startswith(b"\x89PNG")     # a picture is still shown
 
 
@@ -258,7 +258,7 @@ def test_a_filter_returning_the_wrong_thing_is_named(returned, phrase) -> None:
     def my_filter_wrong(y, A, C, Q, R, z0, P0):
         return returned(my_filter(y, A, C, Q, R, z0, P0))
 
-    with pytest.raises(vision.student_code.StudentCodeError, match=r"^my_filter_wrong ") as info:
+    with pytest.raises(StudentCodeError, match=r"^my_filter_wrong ") as info:
         vision.draw_vision(Figure(), sigma_v=1.5, filter=my_filter_wrong)
     assert phrase in str(info.value)
 
@@ -280,12 +280,12 @@ def test_the_filter_gets_copies_and_cannot_spoil_the_next_draw() -> None:
         y[...] = 0.0                                   # changes its input
         return estimates
 
-    with pytest.raises(vision.student_code.StudentCodeError, match="changed its input y"):
+    with pytest.raises(StudentCodeError, match="changed its input y"):
         vision.draw_vision(Figure(), sigma_v=1.5, filter=my_filter_in_place)
     numbers = vision.draw_vision(Figure(), sigma_v=1.5)
     assert numbers == vision.draw_vision(Figure(), sigma_v=1.5)
 
 
 def test_explore_vision_refuses_a_filter_that_is_not_a_function() -> None:
-    with pytest.raises(ValueError, match=r"filter must be your filter function .* got a ndarray"):
+    with pytest.raises(ValueError, match=r"filter must be None .*or a function.* got a ndarray"):
         vision.explore_vision(filter=np.zeros(3))

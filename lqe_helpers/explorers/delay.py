@@ -35,9 +35,9 @@ from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
-from .fusion import with_student_estimates
 from .panels import DATA_UNDER_LINES, reuse_panels
 from .sliders import float_slider, starting_value
+from .student_functions import RERUN, checked_function, refiltered, whose
 
 #: Longest delay the slider offers (s): a quarter of the butterfly's period, far past
 #: the point where prediction stops paying off.
@@ -85,7 +85,7 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
     MSEs (cm², over the whole trial after the burn-in or the delay, whichever is
     longer) with and without compensation, and of the same filter with no delay, as
     one line of text that says whose code ran (the explorer shows it beside the
-    figure), e.g. "Delay d = 0.10 s (δ = 10 steps). MSE of this run (the pack’s
+    figure), e.g. "Delay d = 0.10 s (δ = 10 steps). MSE of this run (the pack's
     engine): delayed 4.99 cm², compensated 1.92 cm², no delay 0.30 cm²."
 
     A figure already drawn by this function for the same scenario keeps its axes and
@@ -131,23 +131,21 @@ def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
                           _whose(filter, compensate))
 
 
+#: What the numbers line calls the pack's filter and eq. (7) beside a student's function.
+PACK_FILTER, PACK_COMPENSATION = "the pack's filter", "the pack's eq. (7)"
+
+
 def _whose(filter: Callable | None, compensate: Callable | None) -> str:
     """Whose code the numbers line reports: "your my_filter and your compensate", …"""
     if filter is None and compensate is None:
-        return "the pack’s engine"
-    parts = ("the pack’s filter" if filter is None
-             else f"your {student_code.function_name(filter)}",
-             "the pack’s eq. (7)" if compensate is None
-             else f"your {student_code.function_name(compensate)}")
-    return " and ".join(parts)
+        return whose(None)
+    return (f"{whose(filter, PACK_FILTER)} and "
+            f"{whose(compensate, PACK_COMPENSATION)}")
 
 
 def _check_functions(filter: object, compensate: object) -> None:
-    for name, function in (("filter", filter), ("compensate", compensate)):
-        if function is not None and not callable(function):
-            raise ValueError(f"{name} must be None or a function (e.g. your my_filter / "
-                             f"compensate, without parentheses), got a "
-                             f"{type(function).__name__}")
+    checked_function("filter", filter)
+    checked_function("compensate", compensate)
 
 
 #: Names of the parameters of a student's ``compensate``, for messages.
@@ -159,11 +157,12 @@ def _filter_run(scenario: Scenario, noise: np.ndarray,
     """The vision-only run on ``noise``: the engine's, or its readings filtered by ``filter``.
 
     With a student's filter the result holds the student's estimates
-    (:func:`~lqe_helpers.explorers.fusion.with_student_estimates`, shared with the fusion
+    (:func:`~lqe_helpers.explorers.student_functions.refiltered`, shared with the other
     explorer); its gains and covariances (which this explorer does not draw) stay the
     engine's.
     """
-    return with_student_estimates(experiments.track(scenario, SENSORS, noise=noise), filter)
+    return refiltered(experiments.track(scenario, SENSORS, noise=noise), filter,
+                      "the explorer's trial of vision")
 
 
 def _compensated(delayed: experiments.DelayedTracking,
@@ -176,7 +175,7 @@ def _compensated(delayed: experiments.DelayedTracking,
     steps = delayed.steps
     output = student_code.call(compensate, estimates, delayed.tracking.scenario.A, steps,
                                name=name, where=f"the explorer's trial with δ = {steps}",
-                               arg_names=_COMPENSATE_ARGS, rerun="run the explorer's cell again")
+                               arg_names=_COMPENSATE_ARGS, rerun=RERUN)
     predictions = student_code.result_array(output, name=name, shape=estimates.shape,
                                             allow_nan=True,
                                             what=f"z*, shape {estimates.shape}")

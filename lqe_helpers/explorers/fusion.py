@@ -17,7 +17,6 @@ not depend on the readings: a student's ``my_filter`` returns estimates only.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -28,7 +27,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
 from matplotlib.text import Annotation
 
-from .. import experiments, student_code, validation
+from .. import experiments, validation
 from ..plotting import COLORS, plot_band
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -44,6 +43,7 @@ from .common import (
 )
 from .panels import DATA_UNDER_LINES, pin_axis_labels, reuse_panels
 from .sliders import float_slider, starting_value
+from .student_functions import StudentFilter, checked_function, refiltered, whose
 
 #: The fused filter's sensors, in the column order of its noise and gains.
 FUSED = ("vision", "proprioception")
@@ -67,13 +67,6 @@ _BAND = "fused band"
 _BAND_LABEL = "fused filter's own ±2 SD"
 #: Title of the right panel; it never changes, so it stays in the cached background.
 SHARES_TITLE = "weights ∝ reliability 1/σ²"
-#: The arguments of a student's filter, in order (notebook 01's ``my_filter``).
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
-#: What the numbers line says runs the filters when no student's filter is given.
-ENGINE = "the pack's engine"
-
-#: A student's filter ``my_filter(y, A, C, Q, R, z0, P0) -> estimates (n, k)``.
-StudentFilter = Callable[..., object]
 
 
 def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarray:
@@ -87,62 +80,19 @@ def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarra
                                    ", ".join(FUSED))
 
 
-def student_filter(filter: StudentFilter | None) -> StudentFilter | None:
-    """``filter`` checked: None (the pack's engine) or a function, else ValueError."""
-    if filter is not None and not callable(filter):
-        raise ValueError(f"filter must be your filter function (e.g. my_filter, without "
-                         f"parentheses) or None for the pack's engine, got a "
-                         f"{type(filter).__name__}")
-    return filter
-
-
-def whose(filter: StudentFilter | None) -> str:
-    """Whose filter runs: "your my_filter" or :data:`ENGINE`."""
-    return ENGINE if filter is None else f"your {student_code.function_name(filter)}"
-
-
-def with_student_estimates(tracking: experiments.Tracking,
-                           filter: StudentFilter | None) -> experiments.Tracking:
-    """``tracking`` with its estimates replaced by ``filter``'s on the same readings and model.
-
-    The student's function runs through :func:`lqe_helpers.student_code.call` on
-    ``tracking``'s readings (n, m) and model (A, C, Q, R, z0, P0) and must return the
-    estimates, shape (n, 3). The gains and covariances stay the engine's: they do not
-    depend on the readings. None returns ``tracking`` itself.
-
-    Raises
-    ------
-    StudentCodeError
-        One line, if the function is not written yet, raises, hangs, or returns anything
-        but a real array of shape (n, 3).
-    """
-    if filter is None:
-        return tracking
-    model, sensors = tracking.model, tracking.sensors
-    name = student_code.function_name(filter)
-    n, k = tracking.result.estimates.shape
-    estimates = student_code.call(
-        filter, tracking.measurements, model.A, model.C, model.Q, model.R, model.z0,
-        model.P0, name=name, arg_names=FILTER_ARGS, rerun="move a slider to try again",
-        where=f"the explorer's trial of {' and '.join(sensors)}")
-    estimates = student_code.result_array(
-        estimates, name=name, shape=(n, k), where="the explorer's trial",
-        what=f"the estimates ẑ, an array of shape (n, k) = ({n}, {k})")
-    return dataclasses.replace(
-        tracking, result=dataclasses.replace(tracking.result, estimates=estimates))
-
-
 def vision_only(scenario: Scenario, sigma_v: float, noise: np.ndarray,
                 filter: StudentFilter | None = None) -> experiments.Tracking:
     """Vision-only tracking of one trial with unit noise ``noise[:, 0]`` scaled by ``sigma_v``.
 
     ``noise`` (n, 2) as :func:`unit_noise` gives it; ``filter`` a student's filter that
-    makes the estimates (:func:`with_student_estimates`), or None for the engine's.
+    makes the estimates (:func:`~lqe_helpers.explorers.student_functions.refiltered`),
+    or None for the engine's.
     Moving σ_p does not change this run, so the explorers keep it between moves
     (:class:`~lqe_helpers.explorers.cache.LastResults`).
     """
     tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise[:, :1])
-    return with_student_estimates(tracking, filter)
+    return refiltered(tracking, filter, f"the explorer's trial of vision at σ_v = "
+                                        f"{sigma_v:g} cm")
 
 
 def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
@@ -179,7 +129,8 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
         σ's; default the scenario's fixed draw. The vision-only filter uses column 0.
     filter : callable, optional
         The student's ``my_filter(y, A, C, Q, R, z0, P0)``, returning the estimates
-        (n, 3): it makes both estimates (:func:`with_student_estimates`). Default: the
+        (n, 3): it makes both estimates
+        (:func:`~lqe_helpers.explorers.student_functions.refiltered`). Default: the
         pack's engine.
 
     Returns
@@ -201,10 +152,11 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
         If a σ is not a finite number > 0, ``noise`` has the wrong shape, or ``filter``
         is neither None nor a function.
     StudentCodeError
-        If the student's filter fails (one line, see :func:`with_student_estimates`).
+        If the student's filter fails (one line, see
+        :func:`~lqe_helpers.explorers.student_functions.refiltered`).
     """
     noise = unit_noise(scenario, noise)
-    filter = student_filter(filter)
+    filter = checked_function("filter", filter)
     return _draw(figure, sigma_v=validation.positive("sigma_v", sigma_v, "cm"),
                  sigma_p=validation.positive("sigma_p", sigma_p, "cm"), scenario=scenario,
                  noise=noise, filter=filter,
@@ -217,8 +169,9 @@ def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
     """:func:`draw_fusion` of inputs already checked; ``vision_runs(σ_v)`` makes or keeps
     the vision-only run (with ``filter``'s estimates)."""
     vision = vision_runs(sigma_v)
-    fused = with_student_estimates(
-        experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise), filter)
+    fused = refiltered(
+        experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p], noise=noise), filter,
+        f"the explorer's trial of both senses at σ_v = {sigma_v:g}, σ_p = {sigma_p:g} cm")
     truth = scenario.truth[:, 0]
     # Share of the position correction each sense receives in the settled filter: the
     # reliability weights 1/σ² normalised, read off the fused filter's own gain.
@@ -315,7 +268,7 @@ def explore_fusion(scenario: Scenario = DEFAULT, *,
         If ``scenario.sigma_v`` or ``scenario.sigma_p`` lies outside the sliders' range
         :data:`SIGMA_RANGE`, or ``filter`` is neither None nor a function.
     """
-    filter = student_filter(filter)
+    filter = checked_function("filter", filter)
     low, high, step = SIGMA_RANGE
     start_v = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
     start_p = starting_value("sigma_p", scenario.sigma_p, low, high, "cm")

@@ -33,12 +33,13 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from .. import experiments, metrics, student_code, validation
+from .. import experiments, metrics, validation
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
 from .sliders import log_slider, starting_value
+from .student_functions import checked_function, refiltered, whose
 
 #: Slider range for P0 (cm², same number for cm²/s² and cm²/s⁴): from "certain of
 #: the initial guess" to "no idea at all".
@@ -55,10 +56,6 @@ VISION_LABEL = "noisy vision"
 ESTIMATE_LABEL = "filtered estimate"
 BAND_LABEL = "±2σ of the filter's own variance"
 
-#: The parameters of a filter function (notebook 01's ``my_filter``), in order.
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
-#: What the numbers line calls the engine.
-ENGINE_NAME = "the pack's engine"
 
 
 def shown_steps(scenario: Scenario) -> int:
@@ -148,42 +145,15 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
         estimates.
     """
     return _draw(figure, p0_variance=validation.positive("p0_variance", p0_variance, "cm²"),
-                 scenario=scenario, noise=noise, filter=_checked_filter(filter))
-
-
-def _checked_filter(filter: object) -> Callable[..., np.ndarray] | None:
-    """``filter`` if it is None or callable, else ValueError naming it."""
-    if filter is not None and not callable(filter):
-        raise ValueError(f"filter must be None (the pack's engine) or a function such as "
-                         f"my_filter, got {type(filter).__name__}")
-    return filter
-
-
-def whose(filter: Callable[..., np.ndarray] | None) -> str:
-    """Whose filter the view shows: "your my_filter", or "the pack's engine"."""
-    return ENGINE_NAME if filter is None else f"your {student_code.function_name(filter)}"
-
-
-def _student_estimates(filter: Callable[..., np.ndarray],
-                       tracking: experiments.Tracking) -> np.ndarray:
-    """The student's filter run on ``tracking``'s readings with its model: (n, 3) estimates."""
-    model = tracking.model
-    name = student_code.function_name(filter)
-    where = f"the explorer's trial with P0 = {float(model.P0[0, 0]):.3g} · I"
-    value = student_code.call(filter, tracking.measurements, model.A, model.C, model.Q,
-                              model.R, model.z0, model.P0, name=name, where=where,
-                              arg_names=FILTER_ARGS, rerun="move the slider again")
-    return student_code.result_array(value, name=name, where=where,
-                                     what="the estimates ẑ, an array of shape (n, 3)",
-                                     shape=tracking.result.estimates.shape)
+                 scenario=scenario, noise=noise, filter=checked_function("filter", filter))
 
 
 def _draw(figure: Figure, *, p0_variance: float, scenario: Scenario,
           noise: np.ndarray | None, filter: Callable[..., np.ndarray] | None = None) -> str:
     """:func:`draw_initial_covariance` of inputs already checked (by it, or by the slider)."""
     tracking = experiments.track(scenario, ("vision",), p0_variance=p0_variance, noise=noise)
-    estimates = (tracking.result.estimates if filter is None
-                 else _student_estimates(filter, tracking))
+    where = f"the explorer's trial with P0 = {p0_variance:.3g} · I"
+    estimates = refiltered(tracking, filter, where).result.estimates
     positions, truth = estimates[:, 0], scenario.truth[:, 0]
     burn_in = scenario.burn_in_steps
     early_mse = float(metrics.mse(positions[:burn_in], truth[:burn_in]))
@@ -250,7 +220,7 @@ def explore_initial_covariance(scenario: Scenario = DEFAULT,
         If ``scenario.p0_variance`` lies outside the slider's range :data:`P0_RANGE`, or
         ``filter`` is neither None nor a function.
     """
-    filter = _checked_filter(filter)
+    filter = checked_function("filter", filter)
     low, high = P0_RANGE
     start = starting_value("p0_variance", scenario.p0_variance, low, high, "cm²")
     noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))

@@ -18,7 +18,6 @@ state, which does not depend on the readings.
 
 from __future__ import annotations
 
-import dataclasses
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -28,7 +27,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import NullLocator
 
-from .. import experiments, student_code, validation
+from .. import experiments, validation
 from ..plotting import COLORS, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -45,6 +44,7 @@ from .common import (
 from .fusion import FUSED, unit_noise, vision_only
 from .panels import pin_axis_labels, reuse_panels
 from .sliders import float_slider
+from .student_functions import checked_function, refiltered, whose
 
 #: σ_p (cm) of question (d).
 QUESTION_SIGMA_P = 4.5
@@ -61,11 +61,6 @@ CURVE_RANGE = (0.3, 100.0)
 
 #: Title of the right panel; it never changes, so it stays in the cached background.
 THEORY_TITLE = "steady state"
-
-#: The parameters of a student's filter, in order (notebook 01's ``my_filter``).
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
-#: The filter a student's function stands in for: the numbers line names it otherwise.
-ENGINE = "the pack's engine"
 
 #: Plotted lines of the left column by gid (see :data:`~.common.TrialLine`).
 _LINES: dict[str, TrialLine] = {
@@ -170,47 +165,17 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
         other than the estimates (one line; the explorer shows it).
     """
     noise = unit_noise(scenario, noise)
-    if filter is not None and not callable(filter):
-        raise ValueError(f"filter must be a function such as my_filter, or None for the "
-                         f"pack's engine, got a {type(filter).__name__}")
+    filter = checked_function("filter", filter)
     return _draw(figure, sigma_p=validation.positive("sigma_p", sigma_p, "cm"),
                  scenario=scenario, noise=noise, filter=filter,
                  vision_run=partial(_vision_run, scenario, noise, filter))
 
 
-def run_by(filter: Callable[..., np.ndarray] | None,
-           tracking: experiments.Tracking, where: str) -> experiments.Tracking:
-    """``tracking`` with its estimates made by ``filter`` from the same readings and model.
-
-    ``filter(y, A, C, Q, R, z0, P0)`` (a student's function) is called through
-    :func:`lqe_helpers.student_code.call` on the tracking's readings (n, m) and the
-    model it assumed, and must return the estimates, shape (n, k). The covariances
-    stay the engine's: they do not depend on the readings. None keeps the engine's run.
-
-    Raises
-    ------
-    StudentCodeError
-        One line naming what went wrong and ``where``.
-    """
-    if filter is None:
-        return tracking
-    name = student_code.function_name(filter)
-    m = tracking.model
-    shape = tracking.result.estimates.shape
-    value = student_code.call(filter, tracking.measurements, m.A, m.C, m.Q, m.R, m.z0, m.P0,
-                              name=name, where=where, arg_names=FILTER_ARGS,
-                              rerun="move the slider again")
-    estimates = student_code.result_array(value, name=name, shape=shape, where=where,
-                                          what=f"the estimates ẑ, shape (n, k) = {shape}")
-    return dataclasses.replace(tracking,
-                               result=dataclasses.replace(tracking.result, estimates=estimates))
-
-
 def _vision_run(scenario: Scenario, noise: np.ndarray,
                 filter: Callable[..., np.ndarray] | None) -> experiments.Tracking:
     """The vision-only run of the trial at the scenario's σ_v, by ``filter``."""
-    return run_by(filter, vision_only(scenario, scenario.sigma_v, noise),
-                  f"the explorer's trial with vision alone, σ_v = {scenario.sigma_v:g} cm")
+    return refiltered(vision_only(scenario, scenario.sigma_v, noise), filter,
+                      f"the explorer's trial with vision alone, σ_v = {scenario.sigma_v:g} cm")
 
 
 def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarray,
@@ -220,9 +185,9 @@ def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarr
     makes or keeps the vision-only run (σ_v is the scenario's, whatever the slider)."""
     sigma_v = scenario.sigma_v
     vision = vision_run()
-    fused = run_by(filter, experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p],
-                                             noise=noise),
-                   f"the explorer's trial with both senses, σ_p = {sigma_p:g} cm")
+    fused = refiltered(experiments.track(scenario, FUSED, sigmas=[sigma_v, sigma_p],
+                                         noise=noise),
+                       filter, f"the explorer's trial with both senses, σ_p = {sigma_p:g} cm")
     truth = scenario.truth[:, 0]
     # The theory at the slider's σ_p: the steady state of the very model the fused
     # filter ran with (the curve's value at this σ_p), and proprioception's share of
@@ -235,10 +200,9 @@ def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarr
     for gid, values in estimate_lines(truth, vision, fused).items():
         panels.trial.lines[gid].set_ydata(values)
     panels.marker.set_data([sigma_p], [theory_now])
-    whose = ENGINE if filter is None else f"your {student_code.function_name(filter)}"
     return (f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} "
             f"Proprioception's weight in the steady state: {100 * weight_p:.1f} %. "
-            f"Estimates from {whose}.")
+            f"Estimates from {whose(filter)}.")
 
 
 class _Panels(NamedTuple):
@@ -280,13 +244,13 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
 
 
 def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFAULT,
-                                    whose: str = ENGINE) -> str:
+                                    filter: Callable[..., object] | None = None) -> str:
     """What :func:`draw_noisier_proprioception` shows at ``sigma_p`` (its alt text).
 
-    ``whose`` names the filter that made the estimates ("your my_filter").
+    ``filter`` is the student's filter that made the estimates, or None (the engine).
     """
     return (f"One trial at σ_v = {scenario.sigma_v:g} cm and σ_p = {sigma_p:.1f} cm. Left: "
-            f"true position, the vision-only and the fused estimate ({whose}), and their "
+            f"true position, the vision-only and the fused estimate ({whose(filter)}), and their "
             f"errors; right: the fused filter's steady-state position variance against σ_p "
             f"(the pack's steady state, which does not depend on the readings), with "
             f"σ_p = {sigma_p:.1f} cm marked, below the vision-only level.")
@@ -316,17 +280,14 @@ def explore_noisier_proprioception(scenario: Scenario = DEFAULT, *,
     ValueError
         If ``filter`` is neither None nor a function.
     """
-    if filter is not None and not callable(filter):
-        raise ValueError(f"filter must be a function such as my_filter, or None for the "
-                         f"pack's engine, got a {type(filter).__name__}")
+    filter = checked_function("filter", filter)
     low, high, step = SIGMA_P_RANGE
     sliders = {"sigma_p": float_slider("σ_p (cm)", START_SIGMA_P, low, high, step,
                                        readout_format=".1f")}
     noise = unit_noise(with_explorer_seed(scenario))
     vision_run = LastResults(partial(_vision_run, scenario, noise, filter))
     draw = partial(_draw, scenario=scenario, noise=noise, vision_run=vision_run, filter=filter)
-    whose = ENGINE if filter is None else f"your {student_code.function_name(filter)}"
     return Explorer("How much does a noisier proprioception help?", sliders, draw,
                     figsize=(10.0, 5.0),
                     describe=partial(describe_noisier_proprioception, scenario=scenario,
-                                     whose=whose))
+                                     filter=filter))

@@ -30,22 +30,18 @@ from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
-from .. import experiments, metrics, student_code, validation
+from .. import experiments, metrics, validation
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
 from .sliders import float_slider, starting_value
+from .student_functions import checked_function, refiltered, whose
 
 #: Slider range for σ_v (cm): from a nearly perfect eye to noise as large as the flight.
 SIGMA_V_RANGE = (0.1, 10.0)
 #: Slider step for σ_v (cm).
 SIGMA_V_STEP = 0.1
-
-#: Parameter names of a filter the explorer runs: ``filter(y, A, C, Q, R, z0, P0)``.
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
-#: How the numbers line names the filter that made the estimate.
-ENGINE_NAME = "the pack's engine"
 
 #: Labels of the plotted artists, so tests and readers can find them.
 TRUTH_LABEL = "true position"
@@ -131,10 +127,8 @@ def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
     """:func:`draw_vision` of a σ_v already checked (by it, or by the slider's range)."""
     tracking = experiments.track(scenario, ("vision",), sigmas=[sigma_v], noise=noise)
     measured = tracking.measurements[:, 0]
-    if filter is None:
-        estimate, whose = tracking.positions, ENGINE_NAME
-    else:
-        estimate, whose = _student_positions(filter, tracking, sigma_v)
+    estimate = refiltered(tracking, filter,
+                          f"the explorer's readings at σ_v = {sigma_v:.1f} cm").positions
     std = np.sqrt(tracking.position_variances)
     raw_mse = float(tracking.measurement_mse("vision"))
     filtered_mse = float(metrics.mse(estimate, scenario.truth[:, 0], scenario.burn_in_steps))
@@ -148,36 +142,16 @@ def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panel.ax, low - margin, high + margin, scenario.amplitude / 2)
-    return (f"σ_v = {sigma_v:.1f} cm, filtered by {whose}. MSE of this run after "
+    return (f"σ_v = {sigma_v:.1f} cm, filtered by {whose(filter)}. MSE of this run after "
             f"{scenario.burn_in:g} s: raw vision {raw_mse:.2f} cm², filtered "
             f"{filtered_mse:.2f} cm².")
-
-
-def _student_positions(filter: Callable[..., np.ndarray], tracking: experiments.Tracking,
-                       sigma_v: float) -> tuple[np.ndarray, str]:
-    """Positions (n,) (cm) of a student's filter on the tracking's readings, and its name.
-
-    Raises StudentCodeError (one line) if the filter fails or returns no (n, 3) array.
-    """
-    name = student_code.function_name(filter)
-    model = tracking.model
-    where = f"the explorer's readings at σ_v = {sigma_v:.1f} cm"
-    output = student_code.call(
-        filter, tracking.measurements, model.A, model.C, model.Q, model.R, model.z0, model.P0,
-        name=name, where=where, arg_names=FILTER_ARGS, rerun="run the explorer's cell again")
-    n, k = tracking.result.estimates.shape
-    estimates = student_code.result_array(
-        output, name=name, what=f"the estimates ẑ, an array of shape (n, k) = {(n, k)}",
-        shape=(n, k), where=where)
-    return estimates[:, 0], f"your {name}"
 
 
 def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT,
                     filter: Callable[..., np.ndarray] | None = None) -> str:
     """One sentence saying what :func:`draw_vision` shows at ``sigma_v`` (its alt text)."""
-    whose = ENGINE_NAME if filter is None else f"your {student_code.function_name(filter)}"
     return (f"Position against time, 0–{scenario.duration:g} s: true path, noisy vision at "
-            f"σ_v = {sigma_v:.1f} cm and the estimate of {whose} with a ±2σ band from the "
+            f"σ_v = {sigma_v:.1f} cm and the estimate of {whose(filter)} with a ±2σ band from the "
             f"engine's covariance sequence, which does not depend on the readings.")
 
 
@@ -211,10 +185,7 @@ def explore_vision(scenario: Scenario = DEFAULT, *,
     """
     low, high = SIGMA_V_RANGE
     start = starting_value("sigma_v", scenario.sigma_v, low, high, "cm")
-    if filter is not None and not callable(filter):
-        raise ValueError(f"filter must be your filter function (e.g. my_filter, without "
-                         f"parentheses) or None for the pack's engine, got a "
-                         f"{type(filter).__name__}")
+    filter = checked_function("filter", filter)
     noise = with_explorer_seed(scenario).unit_noise(sensors=("vision",))
     slider = float_slider("σ_v (cm)", start, low, high, SIGMA_V_STEP, readout_format=".1f")
     return Explorer(
