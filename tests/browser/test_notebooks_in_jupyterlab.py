@@ -30,7 +30,8 @@ from lab_driver import (
     unexecuted_cells,
 )
 
-pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
+# One JupyterLab server for these and the harness test: one pytest-xdist worker runs them.
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300), pytest.mark.xdist_group("jupyterlab")]
 
 
 def explorer_cell_count(path: Path) -> int:
