@@ -22,8 +22,9 @@ from pathlib import Path
 
 import nbformat
 import pytest
-from artefacts import StudentPack, writable_copy
+from artefacts import StudentPack
 from make_env import make_environment
+from once_per_run import writable_copy
 
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp

@@ -1,10 +1,11 @@
 """The suite's own plumbing: shared artefacts built once, the ``kernel`` marker enforced.
 
-tests/artefacts.py builds each costly artefact once per test run, also when pytest-xdist
-runs two sessions at once, and notices a test that changed one; tests/conftest.py fails a
-test that starts a Jupyter kernel without the ``kernel`` marker (which ``make test-fast``
-relies on) and marks nbval's notebook cells. Instructor's side of the suite: tests/artefacts.py
-imports lqe_helpers.authoring, so the student pack leaves this file out.
+tests/once_per_run.py builds each costly artefact of tests/artefacts.py once per test
+run, also when pytest-xdist runs two sessions at once, and notices a test that changed
+one; tests/conftest.py fails a test that starts a Jupyter kernel without the ``kernel``
+marker (which ``make test-fast`` relies on) and marks nbval's notebook cells.
+Instructor's side of the suite: it checks the machinery behind tests/artefacts.py, which
+builds with lqe_helpers.authoring, so the student pack leaves this file out.
 """
 
 from __future__ import annotations
@@ -18,8 +19,8 @@ from pathlib import Path
 
 import nbformat
 import pytest
-from artefacts import SharedArtefacts, writable_copy
 from make_env import make_environment
+from once_per_run import SharedArtefacts, writable_copy
 
 TESTS = Path(__file__).resolve().parent
 
@@ -29,7 +30,7 @@ SESSION = """
 import json, sys, time
 from pathlib import Path
 sys.path.insert(0, {tests!r})
-from artefacts import SharedArtefacts
+from once_per_run import SharedArtefacts
 
 root, worker = Path(sys.argv[1]), sys.argv[2]
 
