@@ -57,11 +57,11 @@ lint: $(STAMP)
 
 # Every test: ruff, the unit tests, nbval over every notebook and the browser tests
 # (skipped with a reason where no Chromium is installed), on every core (pytest-xdist: the
-# cells of a notebook, the JupyterLab tests and the handout tests each stay in one worker;
-# the costly builds are shared, tests/artefacts.py), listing the 15 slowest at the end.
-# PYTEST_ARGS adds pytest options, and they win: PYTEST_ARGS="-n 0" runs in this process
-# (--pdb does so by itself), PYTEST_ARGS=--durations=60 lists more.
-PYTEST_PARALLEL := -n logical --dist loadgroup
+# tests of one file, or of one group of files, run in one worker, in file order; see
+# tests/conftest.py; the costly builds are shared, tests/artefacts.py), listing the 15
+# slowest at the end. PYTEST_ARGS adds pytest options, and they win: PYTEST_ARGS="-n 0"
+# runs in this process (--pdb does so by itself), PYTEST_ARGS=--durations=60 lists more.
+PYTEST_PARALLEL := -n logical --dist loadfile --no-loadscope-reorder
 test: $(STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) --durations=15 tests --nbval notebooks \
 	  --nbval-current-env $(PYTEST_ARGS)

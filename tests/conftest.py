@@ -1,12 +1,14 @@
-"""Shared test configuration: Hypothesis profiles, the ``kernel`` marker, test groups.
+"""Shared test configuration: Hypothesis profiles, the ``kernel`` marker, worker groups.
 
 - Hypothesis: CI (``CI`` set) draws the same examples every run.
 - ``kernel`` (registered in pyproject.toml) marks a test that starts a Jupyter kernel or
   executes a notebook; ``make test-fast`` leaves those out. nbval's notebook cells are
   marked here, and a test that starts a kernel in this process without the marker fails,
   naming the marker, so the fast lane stays fast.
-- pytest-xdist (``make test`` runs ``--dist loadgroup``): the cells of one notebook run
-  in one worker, in order, on one kernel (group ``notebook-<name>``).
+- pytest-xdist: ``make test`` runs ``--dist loadfile``, so the tests of one file (the cells
+  of one notebook, on its one kernel, in order) run in one worker and share its session
+  fixtures; :data:`WORKER_GROUPS` puts files that share a costly resource in one worker
+  too.
 - The costly artefacts every test shares (``handouts_build``, ``student_edition``,
   ``filled_edition``, ``student_pack``) are built by ``tests/artefacts.py``, loaded below
   where it exists: the student pack leaves out that instructor's side of the suite.
@@ -60,11 +62,45 @@ def pytest_configure(config: pytest.Config) -> None:
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """nbval's cells: marked ``kernel``, grouped by notebook for pytest-xdist."""
+    """nbval's notebook cells are marked ``kernel``."""
     for item in items:
         if item.path.suffix == ".ipynb":
             item.add_marker(pytest.mark.kernel)
-            item.add_marker(pytest.mark.xdist_group(f"notebook-{item.path.stem}"))
+
+
+#: Test files (relative to the top folder) that share a costly resource of their pytest
+#: session, so pytest-xdist runs each group in one worker: one Chromium for every
+#: handout page; one JupyterLab server.
+WORKER_GROUPS = {
+    "tests/browser/test_handouts_a11y.py": "handout pages",
+    "tests/browser/test_handouts_offline.py": "handout pages",
+    "tests/browser/test_harness.py": "jupyterlab",
+    "tests/browser/test_notebooks_in_jupyterlab.py": "jupyterlab",
+}
+
+
+def work_unit(nodeid: str) -> str:
+    """What pytest-xdist hands one worker with the test ``nodeid``: its file, or its group."""
+    path = nodeid.split("::", 1)[0]
+    return WORKER_GROUPS.get(path, path)
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_xdist_make_scheduler(config: pytest.Config, log):
+    """``--dist loadfile`` with the files of a :data:`WORKER_GROUPS` group in one worker.
+
+    Not ``--dist loadgroup`` with ``xdist_group`` marks: on pytest 9.2 pytest-xdist 3.8
+    no longer groups by them, silently (pytest-xdist issue 1386).
+    """
+    if config.getvalue("dist") != "loadfile":
+        return None
+    from xdist.scheduler import LoadFileScheduling
+
+    class GroupedFileScheduling(LoadFileScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            return work_unit(nodeid)
+
+    return GroupedFileScheduling(config, log)
 
 
 @pytest.hookimpl(wrapper=True)

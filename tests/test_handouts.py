@@ -263,10 +263,6 @@ def test_the_link_check_can_fail(tmp_path):
 # ---------------------------------------------------------------- the fixture
 
 
-#: The tests of the fixture build run in one pytest-xdist worker, which builds it once.
-FIXTURE_BUILD = pytest.mark.xdist_group("handouts-fixture")
-
-
 @pytest.fixture(scope="session")
 def fixture_build(tmp_path_factory):
     source = tmp_path_factory.mktemp("handout_source")
@@ -281,7 +277,6 @@ def fixture_build(tmp_path_factory):
 
 
 @pytest.mark.kernel
-@FIXTURE_BUILD
 def test_fixture_pages_and_layout(fixture_build):
     out, written = fixture_build
     assert written == [out / "01_fixture.html", out / "02_fixture_again.html", out / "index.html",
@@ -294,7 +289,6 @@ def test_fixture_pages_and_layout(fixture_build):
 
 
 @pytest.mark.kernel
-@FIXTURE_BUILD
 @pytest.mark.parametrize("variant", ["", "prose/"])
 def test_fixture_page_content(fixture_build, variant):
     out, _ = fixture_build
@@ -336,7 +330,6 @@ def test_fixture_page_content(fixture_build, variant):
 
 
 @pytest.mark.kernel
-@FIXTURE_BUILD
 @pytest.mark.parametrize("variant", ["", "prose/"])
 def test_fixture_index_and_navigation(fixture_build, variant):
     out, _ = fixture_build
@@ -603,16 +596,10 @@ def test_notebook_title_falls_back_to_the_file_name():
 # --------------------------------------------------------- the pack's notebooks
 
 
-#: The tests of the pack's handouts run in the pytest-xdist worker of the browser tests
-#: that audit them (the build is shared either way; this saves the other worker a wait).
-HANDOUTS = pytest.mark.xdist_group("handouts")
-
-
 def test_every_pack_notebook_is_checked():
     assert len(REAL) >= 7, REAL
 
 
-@HANDOUTS
 def test_every_notebook_has_both_pages_and_an_index(handouts_build):
     out, written = handouts_build.folder, list(handouts_build.pages)
     expected = [out / f"{stem}.html" for stem in REAL] + [out / "index.html"]
@@ -627,7 +614,6 @@ def test_every_notebook_has_both_pages_and_an_index(handouts_build):
         assert_local_links_resolve(index, out / variant)
 
 
-@HANDOUTS
 @pytest.mark.parametrize("variant", ["", "prose/"])
 @pytest.mark.parametrize("stem", REAL)
 def test_pack_page(handouts_build, stem, variant):

@@ -4,10 +4,10 @@ Unit tests use small notebooks written into tmp_path. The same checks then run o
 every notebook in ``notebooks/``, on the run's one student edition and filled edition
 (``student_edition``, ``filled_edition``: tests/artefacts.py): each student notebook is
 executed once per test run (up to its first stub, then its explorer cells; and its
-explorers again in a fresh kernel after the first code cell only; the two tests of a
-notebook run in one pytest-xdist worker, which keeps the run), and so is each filled
-notebook. A few tests feed the checks a broken notebook, to show that they can fail. Tests
-that execute a notebook are marked ``kernel``.
+explorers again in a fresh kernel after the first code cell only; this file's tests run
+in one pytest-xdist worker, which keeps the run for the two tests of a notebook), and so
+is each filled notebook. A few tests feed the checks a broken notebook, to show that they
+can fail. Tests that execute a notebook are marked ``kernel``.
 """
 
 from __future__ import annotations
@@ -533,12 +533,6 @@ UNCHECKED_TAGS = {"nbval-skip", "nbval-ignore-output", "raises-exception", "skip
 
 CASES = [("fixture", "01_fixture.ipynb")] + [("notebooks", name) for name in REAL]
 IDS = [f"{key}/{name}" for key, name in CASES]
-#: The cases again, for the tests that execute the student notebook: both tests of one
-#: notebook run in one pytest-xdist worker, which executes it once for the two.
-RUN_CASES = [pytest.param(key, name, id=f"{key}/{name}",
-                          marks=[pytest.mark.kernel,
-                                 pytest.mark.xdist_group(f"student-run-{key}-{name}")])
-             for key, name in CASES]
 
 
 def test_every_pack_notebook_is_checked():
@@ -578,12 +572,14 @@ def test_no_solution_or_answer_text_survives(sources, editions, key, name):
     assert_nothing_marked_survives(source, student)
 
 
-@pytest.mark.parametrize(("key", "name"), RUN_CASES)
+@pytest.mark.kernel
+@pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
 def test_student_notebook_runs_until_its_first_stub(student_runs, key, name):
     assert_runs_until_first_stub(student_runs(key, name))
 
 
-@pytest.mark.parametrize(("key", "name"), RUN_CASES)
+@pytest.mark.kernel
+@pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
 def test_explorers_run_on_their_own_in_the_student_edition(student_runs, key, name):
     assert_explorers_work(student_runs(key, name))
 

@@ -151,7 +151,7 @@ def test_a_test_that_starts_a_kernel_without_the_marker_fails(tmp_path):
     shutil.copy(TESTS / "conftest.py", tmp_path / "conftest.py")
     (tmp_path / "pytest.ini").write_text("[pytest]\nmarkers =\n    kernel: starts a kernel\n")
     (tmp_path / "test_kernels.py").write_text(textwrap.dedent(UNMARKED))
-    result = pytest_in(tmp_path, "-rA", "-q")
+    result = pytest_in(tmp_path, "-rA", "-q", "-p", "no:nbval")  # no notebook: start faster
     assert result.returncode == 1, result.stdout[-3000:]
     assert result.stdout.splitlines()[-1].startswith("1 failed, 2 passed"), result.stdout[-3000:]
     assert ("test_kernels.py::test_unmarked started 1 Jupyter kernel(s) but is not marked "
@@ -159,19 +159,22 @@ def test_a_test_that_starts_a_kernel_without_the_marker_fails(tmp_path):
     assert "PASSED test_kernels.py::test_marked" in result.stdout
 
 
-# A plugin that prints what each test left out by -m is marked with.
+# A plugin that prints whether each test left out by -m is marked kernel.
 SHOW_MARKS = """
 def pytest_deselected(items):
     for item in items:
-        groups = [mark.args[0] for mark in item.iter_markers("xdist_group")]
-        print("MARKS", item.nodeid, groups, item.get_closest_marker("kernel") is not None,
-              sep="|")
+        print("MARKS", item.nodeid, item.get_closest_marker("kernel") is not None, sep="|")
 """
 
 
-def test_notebook_cells_carry_the_kernel_marker_and_a_group_of_their_own(tmp_path):
-    shutil.copy(TESTS / "conftest.py", tmp_path / "conftest.py")
-    (tmp_path / "pytest.ini").write_text("[pytest]\nmarkers =\n    kernel: starts a kernel\n")
+def conftest_in(folder: Path) -> None:
+    """This suite's conftest.py in ``folder``, with the ``kernel`` marker registered."""
+    shutil.copy(TESTS / "conftest.py", folder / "conftest.py")
+    (folder / "pytest.ini").write_text("[pytest]\nmarkers =\n    kernel: starts a kernel\n")
+
+
+def test_notebook_cells_carry_the_kernel_marker(tmp_path):
+    conftest_in(tmp_path)
     (tmp_path / "show_marks.py").write_text(SHOW_MARKS)
     notebook = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("1 + 1"),
                                                nbformat.v4.new_code_cell("2 + 2")])
@@ -180,5 +183,38 @@ def test_notebook_cells_carry_the_kernel_marker_and_a_group_of_their_own(tmp_pat
                       "--collect-only", "-q")
     marks = [line.split("|")[1:] for line in shown.stdout.splitlines()
              if line.startswith("MARKS|")]
-    assert marks == [[f"one.ipynb::Cell {index}", "['notebook-one']", "True"]
-                     for index in range(2)], shown.stdout
+    assert marks == [[f"one.ipynb::Cell {index}", "True"] for index in range(2)], shown.stdout
+
+
+# Each test writes down which pytest-xdist worker ran it.
+WHERE = """
+import os
+from pathlib import Path
+
+
+def test_{name}():
+    Path(os.environ["WORKERS_SEEN"], "{name}").write_text(os.environ["PYTEST_XDIST_WORKER"])
+"""
+
+
+def test_the_files_of_a_worker_group_run_in_one_worker(tmp_path):
+    """The two JupyterLab files come first; as two units they would go to two workers."""
+    conftest_in(tmp_path)
+    files = {"lab": "tests/browser/test_notebooks_in_jupyterlab.py",
+             "harness": "tests/browser/test_harness.py", "other": "tests/test_other.py",
+             "more": "tests/test_more.py"}
+    for name, path in files.items():
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text(WHERE.format(name=name))
+    seen = tmp_path / "seen"
+    seen.mkdir()
+    result = subprocess.run(
+        [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-p", "no:nbval", "-q",
+         "-n", "2", "--dist", "loadfile", "--no-loadscope-reorder", "tests"],
+        cwd=tmp_path, capture_output=True, text=True, timeout=300,
+        env=make_environment(WORKERS_SEEN=str(seen)))
+    assert result.returncode == 0, result.stdout[-3000:] + result.stderr[-3000:]
+    workers = {path.name: path.read_text() for path in seen.iterdir()}
+    assert sorted(workers) == sorted(files)
+    assert workers["lab"] == workers["harness"]
+    assert len(set(workers.values())) == 2, workers  # the other files went to the other one

@@ -41,8 +41,7 @@ from offline_pages import (
 from lqe_helpers.authoring.handout_pages import GENERIC_ALT
 from lqe_helpers.authoring.handouts import PROSE_DIR
 
-# In one pytest-xdist worker with the other tests of the handouts build.
-pytestmark = [pytest.mark.browser, pytest.mark.timeout(1800), pytest.mark.xdist_group("handouts")]
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(1800)]
 
 #: Bound of MathJax's typesetting of one page, ms (a page has up to ~200 equations).
 TYPESET_MS = 180_000

@@ -38,7 +38,6 @@ def describe(page: OfflinePage, root: Path) -> str:
     return "\n".join(lines)
 
 
-@pytest.mark.xdist_group("handouts")
 def test_every_handout_image_loads_offline(browser, handout_pages: list[Path]) -> None:
     root = handout_pages[0].parent
     pages = [open_offline(browser, path, screenshot_path(

@@ -32,7 +32,6 @@ from offline_pages import open_offline
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
 
-@pytest.mark.xdist_group("jupyterlab")  # the JupyterLab server of the notebook tests
 def test_harness_catches_errors_skipped_cells_and_dead_sliders(lab_page,
                                                               lab_server: LabServer) -> None:
     page = lab_page

@@ -30,8 +30,7 @@ from lab_driver import (
     unexecuted_cells,
 )
 
-# One JupyterLab server for these and the harness test: one pytest-xdist worker runs them.
-pytestmark = [pytest.mark.browser, pytest.mark.timeout(300), pytest.mark.xdist_group("jupyterlab")]
+pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
 
 def explorer_cell_count(path: Path) -> int:
