@@ -67,10 +67,11 @@ test: $(STAMP) lint
 	  --nbval-current-env $(PYTEST_ARGS)
 
 # The authors' quick check, in under a minute: ruff and every test that starts no Jupyter
-# kernel and no browser (no notebook is executed; `make test` runs everything).
+# kernel and no browser and is not marked slow (no notebook is executed, no make lab, no
+# pytest run inside the student pack; `make test` runs everything).
 test-fast: $(STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) --durations=10 tests \
-	  -m "not kernel and not browser" $(PYTEST_ARGS)
+	  -m "not kernel and not browser and not slow" $(PYTEST_ARGS)
 
 # Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
 notebooks: $(STAMP)

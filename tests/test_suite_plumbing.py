@@ -173,6 +173,7 @@ def conftest_in(folder: Path) -> None:
     (folder / "pytest.ini").write_text("[pytest]\nmarkers =\n    kernel: starts a kernel\n")
 
 
+@pytest.mark.slow
 def test_notebook_cells_carry_the_kernel_marker(tmp_path):
     conftest_in(tmp_path)
     (tmp_path / "show_marks.py").write_text(SHOW_MARKS)
@@ -197,6 +198,7 @@ def test_{name}():
 """
 
 
+@pytest.mark.slow
 def test_the_files_of_a_worker_group_run_in_one_worker(tmp_path):
     """The two JupyterLab files come first; as two units they would go to two workers."""
     conftest_in(tmp_path)
