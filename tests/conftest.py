@@ -9,9 +9,10 @@
   of one notebook, on its one kernel, in order) run in one worker and share its session
   fixtures; :data:`WORKER_GROUPS` puts files that share a costly resource in one worker
   too.
-- The costly artefacts every test shares (``handouts_build``, ``student_edition``,
-  ``filled_edition``, ``student_pack``) are built by ``tests/artefacts.py``, loaded below
-  where it exists: the student pack leaves out that instructor's side of the suite.
+- The costly artefacts that tests share (the handouts, the student edition and pack) are
+  the fixtures of ``tests/artefacts.py``, loaded below where it exists: the student pack
+  leaves out that instructor's side of the suite (and this file names none of them, so
+  that a test that names one can be told from the student's tests).
 """
 
 from __future__ import annotations
