@@ -66,10 +66,10 @@ test: $(STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) --durations=15 tests --nbval notebooks \
 	  --nbval-current-env $(PYTEST_ARGS)
 
-# The authors' quick check, in under a minute: ruff and every test that starts no Jupyter
-# kernel and no browser and is not marked slow (no notebook is executed, no make lab, no
-# pytest run inside the student pack; `make test` runs everything). Without nbval, which
-# it does not use, pytest starts a second sooner.
+# The authors' quick check, meant to take under a minute: ruff and every test that starts
+# no Jupyter kernel and no browser and is not marked slow (no notebook is executed, no make
+# lab, no pytest run inside the student pack; `make test` runs everything). Without nbval,
+# which it does not use, pytest starts a second sooner.
 test-fast: $(STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -p no:nbval --durations=10 tests \
 	  -m "not kernel and not browser and not slow" $(PYTEST_ARGS)
