@@ -1,6 +1,7 @@
 # The two commands a student or instructor needs are `make lab` and `make test`.
 # Both create .venv on first use and re-install only when pyproject.toml or
-# constraints.txt changed, so a second run starts at once.
+# constraints.txt changed, so a second run starts at once. `make test-fast` is the
+# authors' quick check (no notebook executed, no browser).
 
 PYTHON ?= python3
 # The pack's own virtualenv, always .venv here: never taken from the environment or the
@@ -23,7 +24,7 @@ CHECK_VENV = if [ -e $(VENV) ] || [ -L $(VENV) ]; then reason=""; \
 	if [ -n "$$reason" ]; then \
 	  echo "error: .venv is broken ($$reason); run make clean, then make lab" >&2; exit 1; fi; fi
 
-.PHONY: lab test lint notebooks handouts student student-pack bench bench-browser clean
+.PHONY: lab test test-fast lint notebooks handouts student student-pack bench bench-browser clean
 
 $(BIN)/python:
 	@$(CHECK_VENV)
@@ -55,9 +56,23 @@ lint: $(STAMP)
 	$(BIN)/ruff check lqe_helpers tests benchmarks notebooks
 
 # Every test: ruff, the unit tests, nbval over every notebook and the browser tests
-# (skipped with a reason where no Chromium is installed).
+# (skipped with a reason where no Chromium is installed), on every core (pytest-xdist: the
+# tests of one file, or of one group of files, run in one worker, in file order; see
+# tests/conftest.py; the costly builds are shared, tests/artefacts.py), listing the 15
+# slowest at the end. PYTEST_ARGS adds pytest options, and they win: PYTEST_ARGS="-n 0"
+# runs in this process (--pdb does so by itself), PYTEST_ARGS=--durations=60 lists more.
+PYTEST_PARALLEL := -n logical --dist loadfile --no-loadscope-reorder
 test: $(STAMP) lint
-	$(BIN)/python -m pytest tests --nbval notebooks --nbval-current-env $(PYTEST_ARGS)
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) --durations=15 tests --nbval notebooks \
+	  --nbval-current-env $(PYTEST_ARGS)
+
+# The authors' quick check, meant to take under a minute: ruff and every test that starts
+# no Jupyter kernel and no browser and is not marked slow (no notebook is executed, no make
+# lab, no pytest run inside the student pack; `make test` runs everything). Without nbval,
+# which it does not use, pytest starts a second sooner.
+test-fast: $(STAMP) lint
+	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -p no:nbval --durations=10 tests \
+	  -m "not kernel and not browser and not slow" $(PYTEST_ARGS)
 
 # Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
 notebooks: $(STAMP)

@@ -1,9 +1,10 @@
 """HTML handouts: one offline page per notebook, figures embedded, explorers static.
 
-The handouts of a small fixture folder and of ``notebooks/`` are each built once per
-test session (every notebook executed fresh once); the tests parse the pages. The
-page checks are plain functions; a few tests feed them broken HTML to show that they
-can fail.
+The handouts of a small fixture folder are built once per test session, and those of
+``notebooks/`` once per test run (the ``handouts_build`` artefact of tests/artefacts.py,
+shared with the browser tests); the tests parse the pages. The page checks are plain
+functions; a few tests feed them broken HTML to show that they can fail. Tests that build
+handouts execute notebooks: they are marked ``kernel``.
 """
 
 from __future__ import annotations
@@ -276,6 +277,7 @@ def fixture_build(tmp_path_factory):
     return out, written
 
 
+@pytest.mark.kernel
 def test_fixture_pages_and_layout(fixture_build):
     out, written = fixture_build
     assert written == [out / "01_fixture.html", out / "02_fixture_again.html", out / "index.html",
@@ -287,6 +289,7 @@ def test_fixture_pages_and_layout(fixture_build):
     assert sorted(rest) == sorted([*written, out / "prose", out / MANIFEST_NAME])
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize("variant", ["", "prose/"])
 def test_fixture_page_content(fixture_build, variant):
     out, _ = fixture_build
@@ -327,6 +330,7 @@ def test_fixture_page_content(fixture_build, variant):
         assert "import numpy as np" in text
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize("variant", ["", "prose/"])
 def test_fixture_index_and_navigation(fixture_build, variant):
     out, _ = fixture_build
@@ -345,6 +349,7 @@ def test_fixture_index_and_navigation(fixture_build, variant):
     assert_local_links_resolve(index, out / variant)
 
 
+@pytest.mark.kernel
 def test_without_mathjax_there_is_no_script_at_all(tmp_path):
     write_fixture(tmp_path / "src", cells=CELLS[:1])
     written = handouts.build_handouts(tmp_path / "src", tmp_path / "out", mathjax_url="")
@@ -359,6 +364,7 @@ BROKEN = [new_markdown_cell("# Broken"), new_code_cell("x = 1"),
           new_code_cell("print('after the error')")]
 
 
+@pytest.mark.kernel
 def test_a_notebook_that_raises_stops_the_build_naming_the_cell(tmp_path):
     write_fixture(tmp_path / "src", "03_broken", BROKEN)
     out = tmp_path / "out"
@@ -380,6 +386,7 @@ def test_a_notebook_that_raises_stops_the_build_naming_the_cell(tmp_path):
     assert sorted(out.rglob("*")) == before, "a failed build must write and delete nothing"
 
 
+@pytest.mark.kernel
 def test_an_allowed_error_still_stops_the_build(tmp_path):
     cell = new_code_cell("raise KeyError('boom')", metadata={"tags": ["raises-exception"]})
     write_fixture(tmp_path / "src", "04_shows_error", [cell])
@@ -387,6 +394,7 @@ def test_an_allowed_error_still_stops_the_build(tmp_path):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
 
 
+@pytest.mark.kernel
 def test_a_bare_widget_stops_the_build(tmp_path):
     cells = [new_code_cell("import ipywidgets\nipywidgets.IntSlider(description='n')")]
     write_fixture(tmp_path / "src", "05_bare_widget", cells)
@@ -394,6 +402,7 @@ def test_a_bare_widget_stops_the_build(tmp_path):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
 
 
+@pytest.mark.kernel
 def test_stderr_is_reported(tmp_path):
     cells = [new_code_cell("import sys\nprint('careful: deprecated', file=sys.stderr)")]
     write_fixture(tmp_path / "src", "06_warns", cells)
@@ -430,6 +439,7 @@ def snapshot(folder: Path) -> dict[str, bytes | str]:
             for path in sorted(folder.rglob("*"))}
 
 
+@pytest.mark.kernel
 def test_a_rebuild_replaces_only_its_own_pages(tmp_path):
     """The issue's case: course_home.html kept, the stale page of a renamed notebook gone."""
     source, out = tmp_path / "src", tmp_path / "out"
@@ -464,6 +474,7 @@ def test_an_index_it_did_not_write_stops_the_build(tmp_path, monkeypatch):
     assert snapshot(out) == before
 
 
+@pytest.mark.kernel
 def test_a_full_disk_while_writing_pages_changes_nothing(tmp_path, monkeypatch):
     write_fixture(tmp_path / "src", cells=CELLS[:1])
     out = tmp_path / "out"
@@ -487,6 +498,7 @@ def test_a_full_disk_while_writing_pages_changes_nothing(tmp_path, monkeypatch):
     assert snapshot(tmp_path) == before
 
 
+@pytest.mark.kernel
 def test_names_with_spaces_and_accents_link_from_the_index(tmp_path):
     source = tmp_path / "src"
     names = ["01 first page", "02 café ΔΣ", "03 #hash?"]
@@ -507,6 +519,7 @@ def test_names_with_spaces_and_accents_link_from_the_index(tmp_path):
     assert handouts.Page("02 café ΔΣ", "t").href == "02%20caf%C3%A9%20%CE%94%CE%A3.html"
 
 
+@pytest.mark.kernel
 def test_command_line(tmp_path, capsys):
     write_fixture(tmp_path / "src", cells=CELLS[:1])
     out = tmp_path / "out"
@@ -538,6 +551,7 @@ def test_command_line(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_a_cell_past_the_time_limit_is_one_error_line(tmp_path, capsys):
     cells = [new_code_cell("import time\nwhile True:\n    time.sleep(0.1)")]
     write_fixture(tmp_path / "src", "01_endless", cells)
@@ -583,20 +597,12 @@ def test_notebook_title_falls_back_to_the_file_name():
 # --------------------------------------------------------- the pack's notebooks
 
 
-@pytest.fixture(scope="session")
-def pack_build(tmp_path_factory):
-    if not REAL:
-        pytest.skip("no notebooks in notebooks/")
-    out = tmp_path_factory.mktemp("pack_handouts")
-    return out, handouts.build_handouts(NOTEBOOKS, out)
-
-
 def test_every_pack_notebook_is_checked():
     assert len(REAL) >= 7, REAL
 
 
-def test_every_notebook_has_both_pages_and_an_index(pack_build):
-    out, written = pack_build
+def test_every_notebook_has_both_pages_and_an_index(handouts_build):
+    out, written = handouts_build.folder, list(handouts_build.pages)
     expected = [out / f"{stem}.html" for stem in REAL] + [out / "index.html"]
     expected += [out / "prose" / path.name for path in expected]
     assert written == expected
@@ -611,8 +617,8 @@ def test_every_notebook_has_both_pages_and_an_index(pack_build):
 
 @pytest.mark.parametrize("variant", ["", "prose/"])
 @pytest.mark.parametrize("stem", REAL)
-def test_pack_page(pack_build, stem, variant):
-    out, _ = pack_build
+def test_pack_page(handouts_build, stem, variant):
+    out = handouts_build.folder
     page = soup(out / variant / f"{stem}.html")
     source = nbformat.read(NOTEBOOKS / f"{stem}.ipynb", as_version=4)
     assert_offline(page, local_mathjax(variant))

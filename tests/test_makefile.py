@@ -21,6 +21,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from make_env import make_environment, makefile_variables
 
 from lqe_helpers.authoring.output_folder import write_output_folder
 
@@ -42,11 +43,24 @@ def snapshot(folder: Path) -> dict[str, bytes | str]:
 
 def make(folder: Path, *targets: str, env: dict[str, str] | None = None,
          timeout: float = 60) -> subprocess.CompletedProcess[str]:
-    environment = {key: value for key, value in os.environ.items()
-                   if key not in {"MAKEFLAGS", "MFLAGS", "MAKELEVEL", "VENV"}}
-    environment.update(env or {})
-    return subprocess.run([MAKE, "--no-print-directory", *targets], cwd=folder, env=environment,
-                          capture_output=True, text=True, timeout=timeout, check=False)
+    return subprocess.run([MAKE, "--no-print-directory", *targets], cwd=folder,
+                          env=make_environment(**(env or {})), capture_output=True, text=True,
+                          timeout=timeout, check=False)
+
+
+def test_a_make_started_by_a_test_inherits_nothing_of_the_callers_make(monkeypatch):
+    """``make test PYTEST_ARGS=--durations=60`` exports it, and MAKEFLAGS passes it on."""
+    assert {"PYTEST_ARGS", "PYTHON", "CONSTRAINTS", "LAB_ARGS", "VENV"} <= makefile_variables()
+    for name, value in {"MAKEFLAGS": " -- PYTEST_ARGS=--durations=60", "MFLAGS": "-s",
+                        "MAKELEVEL": "1", "PYTEST_ARGS": "--durations=60", "LAB_ARGS": "x",
+                        "PYTEST_ADDOPTS": "-x", "PYTEST_XDIST_WORKER": "gw1"}.items():
+        monkeypatch.setenv(name, value)
+    environment = make_environment(remove=["HOME"], VENV="kept")
+    for name in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "PYTEST_ARGS", "LAB_ARGS", "PYTEST_ADDOPTS",
+                 "PYTEST_XDIST_WORKER", "HOME"):
+        assert name not in environment, name
+    assert environment["VENV"] == "kept"
+    assert environment["PATH"] == os.environ["PATH"]
 
 
 @pytest.fixture
@@ -192,9 +206,7 @@ def test_make_lab_starts_jupyterlab_and_prints_its_url(tmp_path):
     if not (ROOT / ".venv" / "bin" / "python").exists():
         pytest.fail("this checkout has no .venv: run make test, which creates it")
     port = free_port()
-    env = {key: value for key, value in os.environ.items()
-           if key not in {"DISPLAY", "WAYLAND_DISPLAY", "BROWSER", "MAKEFLAGS", "MFLAGS",
-                          "MAKELEVEL", "VENV"}}
+    env = make_environment(remove=["DISPLAY", "WAYLAND_DISPLAY", "BROWSER"])
     for name in ("JUPYTER_CONFIG_DIR", "JUPYTER_RUNTIME_DIR", "JUPYTER_DATA_DIR", "IPYTHONDIR",
                  "JUPYTERLAB_WORKSPACES_DIR", "JUPYTERLAB_SETTINGS_DIR"):
         env[name] = str(tmp_path / name.lower())

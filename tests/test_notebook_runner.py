@@ -115,6 +115,7 @@ def test_a_linked_notebook_is_refused(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_a_good_notebook_is_not_rewritten_before_a_bad_one_fails(tmp_path, capsys):
     good = write(tmp_path / "good.ipynb", "print('ran')")
     bad = write(tmp_path / "bad.ipynb", "x = 1", "x / 0")
@@ -129,6 +130,7 @@ def test_a_good_notebook_is_not_rewritten_before_a_bad_one_fails(tmp_path, capsy
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_verbose_shows_the_cell_traceback(tmp_path, capsys):
     bad = write(tmp_path / "bad.ipynb", "x = 1", "x / 0")
     assert notebook_runner.main([str(bad), "--verbose"]) == 1
@@ -140,6 +142,7 @@ def test_verbose_shows_the_cell_traceback(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_a_kernel_that_dies_is_one_error_line(tmp_path, capsys):
     good = write(tmp_path / "good.ipynb", "print('ran')")
     dying = write(tmp_path / "dying.ipynb", "print('start')", "import os\nos._exit(1)")
@@ -151,6 +154,7 @@ def test_a_kernel_that_dies_is_one_error_line(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_a_cell_past_its_time_limit_is_one_error_line(tmp_path, capsys):
     good = write(tmp_path / "good.ipynb", "print('ran')")
     endless = write(tmp_path / "endless.ipynb", "import time", "while True:\n    time.sleep(0.1)")
@@ -163,6 +167,7 @@ def test_a_cell_past_its_time_limit_is_one_error_line(tmp_path, capsys):
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_a_full_disk_while_saving_leaves_every_notebook_as_it_was(tmp_path, capsys,
                                                                    monkeypatch):
     first = write(tmp_path / "01.ipynb", "print('one')")
@@ -187,6 +192,7 @@ def test_a_full_disk_while_saving_leaves_every_notebook_as_it_was(tmp_path, caps
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_notebooks_are_saved_together_and_unchanged_ones_not_rewritten(tmp_path, capsys):
     first = write(tmp_path / "01.ipynb", "print('one')")
     second = write(tmp_path / "02.ipynb", "print('two')")
@@ -208,6 +214,7 @@ def test_notebooks_are_saved_together_and_unchanged_ones_not_rewritten(tmp_path,
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
 def test_allow_errors_keeps_the_error_in_the_outputs(tmp_path):
     path = write(tmp_path / "errors.ipynb", "1 / 0", "print('still runs')")
     notebook = notebook_runner.execute_notebook(path, allow_errors=True)
@@ -219,6 +226,7 @@ def test_allow_errors_keeps_the_error_in_the_outputs(tmp_path):
     assert notebook.cells[1].outputs[0]["text"] == "still runs\n"
 
 
+@pytest.mark.kernel
 def test_a_stream_is_one_output_however_the_kernel_chunked_it(tmp_path):
     source = ("import sys, time\n"
               "print('first', flush=True)\n"

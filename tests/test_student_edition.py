@@ -1,10 +1,13 @@
 """The student edition: solutions become stubs, answers become prompts, explorers stay.
 
 Unit tests use small notebooks written into tmp_path. The same checks then run on
-every notebook in ``notebooks/``: each student notebook is executed once per test
-session (up to its first stub, then its explorer cells; and its explorers again in a
-fresh kernel after the first code cell only) and the results are shared. A few
-tests feed the checks a broken notebook, to show that they can fail.
+every notebook in ``notebooks/``, on the run's one student edition and filled edition
+(``student_edition``, ``filled_edition``: tests/artefacts.py): each student notebook is
+executed once per test run (up to its first stub, then its explorer cells; and its
+explorers again in a fresh kernel after the first code cell only; this file's tests run
+in one pytest-xdist worker, which keeps the run for the two tests of a notebook), and so
+is each filled notebook. A few tests feed the checks a broken notebook, to show that they
+can fail. Tests that execute a notebook are marked ``kernel``.
 """
 
 from __future__ import annotations
@@ -15,11 +18,13 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from artefacts import FilledEdition, RunError, StudentEdition, filled_core, run_notebook
 from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers.authoring import student_edition as se
+from lqe_helpers.authoring import student_pack as sp
 
 NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
 REAL = sorted(path.name for path in NOTEBOOKS.glob("*.ipynb"))
@@ -386,7 +391,7 @@ def test_a_notebook_without_solution_cells_is_refused(tmp_path):
     assert "times_secret" in written[1].read_text()
 
 
-# ------------------------------------------- every notebook, executed once a session
+# ------------------------------------------- every notebook, executed once a run
 
 
 @pytest.fixture(scope="session")
@@ -398,20 +403,13 @@ def sources(tmp_path_factory) -> dict[str, Path]:
 
 
 @pytest.fixture(scope="session")
-def editions(sources, tmp_path_factory) -> dict[str, Path]:
-    """The student edition of each source folder, notebook by notebook.
-
-    Built one notebook at a time (not with build_student_edition, which refuses a
-    folder holding a notebook without solution cells) so that each notebook's tests
-    report on that notebook alone.
-    """
-    built = {}
-    for key, folder in sources.items():
-        built[key] = tmp_path_factory.mktemp(f"student_{key}")
-        for path in sorted(folder.glob("*.ipynb")):
-            text = se.student_edition(nbformat.read(path, as_version=4), path.stem)
-            (built[key] / path.name).write_text(text, encoding="utf-8")
-    return built
+def editions(sources, tmp_path_factory, student_edition: StudentEdition) -> dict[str, Path]:
+    """The student edition of each source folder: the fixture's, and the run's of the pack."""
+    fixture_edition = tmp_path_factory.mktemp("student_fixture")
+    for path in sorted(sources["fixture"].glob("*.ipynb")):
+        text = se.student_edition(nbformat.read(path, as_version=4), path.stem)
+        (fixture_edition / path.name).write_text(text, encoding="utf-8")
+    return {"fixture": fixture_edition, "notebooks": student_edition.folder}
 
 
 def run_cell(client: NotebookClient, cell: nbformat.NotebookNode,
@@ -508,6 +506,7 @@ def student_runs(sources, editions):
     return run
 
 
+@pytest.mark.kernel
 def test_the_run_checks_can_fail(tmp_path):
     """A cell before the first stub that raises, and an explorer that needs a solution."""
     notebook = fixture_notebook()
@@ -573,11 +572,13 @@ def test_no_solution_or_answer_text_survives(sources, editions, key, name):
     assert_nothing_marked_survives(source, student)
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
 def test_student_notebook_runs_until_its_first_stub(student_runs, key, name):
     assert_runs_until_first_stub(student_runs(key, name))
 
 
+@pytest.mark.kernel
 @pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
 def test_explorers_run_on_their_own_in_the_student_edition(student_runs, key, name):
     assert_explorers_work(student_runs(key, name))
@@ -585,31 +586,14 @@ def test_explorers_run_on_their_own_in_the_student_edition(student_runs, key, na
 
 # ---------------------- a student who writes the worked solutions passes every check
 
-QUESTION_NOTEBOOKS = [name for name in REAL if name[:3] in {"01_", "02_", "03_", "04_", "05_"}]
+#: The tutorial's question notebooks: every task of their core path has a check.
+QUESTION_NOTEBOOKS = [name for name in REAL if name.startswith(sp.CHECKED_PREFIXES)]
 
 
-def core_end(notebook: nbformat.NotebookNode) -> int:
-    """Index of the ``## Going further`` heading cell (the end of the core path)."""
-    return next((index for index, cell in enumerate(notebook.cells)
-                 if cell.cell_type == "markdown"
-                 and cell.source.lstrip().startswith(se.GOING_FURTHER)), len(notebook.cells))
-
-
-def filled_core(source: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
-    """The student edition's core path with every task filled with the worked solution.
-
-    Task i of the edition gets the code of solution cell i of the source (the edition
-    keeps the cells in order); everything after ``## Going further`` is left out.
-    """
-    student = nbformat.reads(se.student_edition(source, name), as_version=4)
-    solutions = [cell for cell in source.cells if se.SOLUTION_TAG in tags(cell)]
-    stubs = [cell for cell in student.cells if se.TASK_TAG in tags(cell)]
-    assert len(stubs) == len(solutions)
-    for stub, solution in zip(stubs, solutions, strict=True):
-        assert stub.source.splitlines()[0] == solution.source.splitlines()[0]
-        stub.source = solution.source
-    student.cells = student.cells[:core_end(student)]
-    return student
+def filled_fixture(source: nbformat.NotebookNode) -> nbformat.NotebookNode:
+    """:func:`artefacts.filled_core` of a fixture notebook's student edition."""
+    return filled_core(source, nbformat.reads(se.student_edition(source, "fixture"),
+                                              as_version=4))
 
 
 def check_cells(notebook: nbformat.NotebookNode) -> list[int]:
@@ -619,19 +603,7 @@ def check_cells(notebook: nbformat.NotebookNode) -> list[int]:
             and not tags(notebook.cells[index + 1])]
 
 
-def run_filled(notebook: nbformat.NotebookNode, cwd: Path) -> CellExecutionError | None:
-    """Execute ``notebook`` in a fresh kernel; the error that stopped it, if any."""
-    client = NotebookClient(notebook, timeout=300, kernel_name="python3",
-                            resources={"metadata": {"path": str(cwd)}})
-    try:
-        client.execute()
-    except CellExecutionError as error:
-        return error
-    return None
-
-
-def assert_every_check_passed(notebook: nbformat.NotebookNode,
-                              error: CellExecutionError | None) -> None:
+def assert_every_check_passed(notebook: nbformat.NotebookNode, error: RunError | None) -> None:
     assert error is None, f"the filled student edition stopped: {error}"
     for index in check_cells(notebook):
         cell = notebook.cells[index]
@@ -641,6 +613,7 @@ def assert_every_check_passed(notebook: nbformat.NotebookNode,
         assert printed.startswith("✓ "), f"check cell {index} ({cell.source}) printed {printed!r}"
 
 
+@pytest.mark.kernel
 def test_the_filled_edition_run_can_fail(tmp_path):
     """A wrong solution in a task makes its check fail; a right one passes."""
     from lqe_helpers import checks
@@ -655,25 +628,31 @@ def test_the_filled_edition_run_can_fail(tmp_path):
                new_markdown_cell("## Going further\n\nOptional."),
                new_code_cell("raise RuntimeError('not reached: Going further is left out')")],
         metadata={"kernelspec": KERNELSPEC, "language_info": {"name": "python"}})
-    filled = filled_core(notebook, "fixture")
+    filled = filled_fixture(notebook)
     assert check_cells(filled) == [4]  # the note comes in at 1
-    assert_every_check_passed(filled, run_filled(filled, tmp_path))
+    assert_every_check_passed(filled, run_notebook(filled, tmp_path))
     notebook.cells[2].source = right.replace("1e5 * np.eye(3)", "np.sqrt(1e5) * np.eye(3)")
-    filled = filled_core(notebook, "fixture")
-    error = run_filled(filled, tmp_path)
+    filled = filled_fixture(notebook)
+    error = run_notebook(filled, tmp_path)
     assert error is not None and error.ename == "CheckFailed"
     with pytest.raises(AssertionError):
         assert_every_check_passed(filled, error)
 
 
+def test_the_filled_edition_holds_every_question_notebook(filled_edition: FilledEdition):
+    assert filled_edition.names == tuple(QUESTION_NOTEBOOKS)
+    assert len(QUESTION_NOTEBOOKS) == 5, QUESTION_NOTEBOOKS
+
+
 @pytest.mark.slow
+@pytest.mark.kernel
 @pytest.mark.parametrize("name", QUESTION_NOTEBOOKS)
-def test_worked_solutions_pass_every_check_in_the_student_edition(name):
+def test_worked_solutions_pass_every_check_in_the_student_edition(filled_edition: FilledEdition,
+                                                                  name):
     """Core path only (up to ``## Going further``): that is where every task has a check."""
-    source = nbformat.read(NOTEBOOKS / name, as_version=4)
-    filled = filled_core(source, Path(name).stem)
-    assert check_cells(filled), f"{name}: no task of the core path is followed by a check"
-    assert_every_check_passed(filled, run_filled(filled, NOTEBOOKS))
+    run = filled_edition.run(name)
+    assert check_cells(run.notebook), f"{name}: no task of the core path is followed by a check"
+    assert_every_check_passed(run.notebook, run.error)
 
 
 # ==================================================================================

@@ -1,10 +1,11 @@
 """The student edition does not give the answers away.
 
 For every notebook in ``notebooks/`` (the worked, executed notebooks) the student
-edition is built (``student_edition.student_edition``) and searched for two kinds of
-leak. "The student edition" is everything in the student notebook: the source of every
-cell (markdown and code, the kept ``# Task:`` comments and check cells included) and any
-output (the build clears them, so there should be none).
+edition (the run's one build, ``student_edition`` in tests/artefacts.py, as ``make
+student`` builds it) is searched for two kinds of leak. "The student edition" is
+everything in the student notebook: the source of every cell (markdown and code, the kept
+``# Task:`` comments and check cells included) and any output (the build clears them, so
+there should be none).
 
 1. **A sentence of a worked answer.** The body of every cell tagged ``answer`` (its text
    below the headings the edition keeps on purpose) is cut into sentences: at blank
@@ -50,6 +51,7 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from artefacts import StudentEdition
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers.authoring import student_edition as se
@@ -302,13 +304,14 @@ def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
-def test_the_student_edition_gives_no_answer_away(path):
+def test_the_student_edition_gives_no_answer_away(student_edition: StudentEdition, path):
     source = nbformat.read(path, as_version=4)
     assert any(cell.get("execution_count") for cell in source.cells
                if cell.cell_type == "code"), (
         f"{path.name} has not been executed: its printed results are unknown "
         f"(run `make notebooks`)")
-    leaks = find_leaks(source, student_of(source, path.stem))
+    student = nbformat.read(student_edition.folder / path.name, as_version=4)
+    leaks = find_leaks(source, student)
     assert not leaks, f"{len(leaks)} leak(s) in the student edition:\n" + "\n".join(leaks)
 
 

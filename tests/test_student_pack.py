@@ -1,19 +1,20 @@
 """``make student-pack``: one zip a student unpacks and uses with ``make lab``.
 
-The pack is built once per module from this course folder (the real notebooks, package
-and Makefile) and unpacked into a temporary folder. Its contents are checked; its
-Makefile is compared with the course's by ``make -n`` (dry runs: nothing is installed);
-and the pytest command of its ``make test`` is run with the current interpreter (no new
-virtualenv): every test of the pack is collected against the pack's own package, and the
-structure tests of the student notebooks and a sample of the unit tests are run. The unit
-tests in the pack are copies of this folder's, which the course's own run executes in full.
+The pack is built once per test run from this course folder (the real notebooks, package
+and Makefile) and unpacked into a temporary folder (``student_pack``, tests/artefacts.py).
+Its contents are checked; its Makefile is compared with the course's by ``make -n`` (dry
+runs: nothing is installed, and nothing of how this run's ``make`` was called reaches them:
+tests/make_env.py); and the pytest command of its ``make test`` is run with the current
+interpreter (no new virtualenv) in a copy of the pack: every test of the pack is collected
+against the pack's own package, and the structure tests of the student notebooks and a
+sample of the unit tests are run. The unit tests in the pack are copies of this folder's,
+which the course's own run executes in full.
 """
 
 from __future__ import annotations
 
 import json
 import shlex
-import shutil
 import subprocess
 import sys
 import zipfile
@@ -21,6 +22,9 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from artefacts import StudentPack
+from make_env import make_environment
+from once_per_run import writable_copy
 
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
@@ -32,15 +36,10 @@ NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 SAMPLE_UNIT_TESTS = ("test_reference", "test_scenario")
 
 
-@pytest.fixture(scope="module")
-def pack(tmp_path_factory) -> tuple[Path, Path]:
-    """(the zip, the folder it unpacks to)."""
-    out = tmp_path_factory.mktemp("pack") / "out"
-    archive = sp.build_student_pack(ROOT, out)
-    unpacked = tmp_path_factory.mktemp("unpacked")
-    with zipfile.ZipFile(archive) as opened:
-        opened.extractall(unpacked)
-    return archive, unpacked / sp.PACK_NAME
+@pytest.fixture
+def pack(student_pack: StudentPack) -> tuple[Path, Path]:
+    """(the zip, the folder it unpacks to): the run's student pack, read-only."""
+    return student_pack.archive, student_pack.folder
 
 
 def names(archive: Path) -> list[str]:
@@ -52,7 +51,8 @@ def dry_run(folder: Path, target: str, **variables: str) -> list[str]:
     """The commands ``make -n -B target`` would run in ``folder`` (nothing is executed)."""
     settings = [f"{name}={value}" for name, value in variables.items()]
     result = subprocess.run(["make", "-n", "-B", "-C", str(folder), "--no-print-directory",
-                             target, *settings], capture_output=True, text=True, check=True)
+                             target, *settings], capture_output=True, text=True, check=True,
+                            env=make_environment())
     return result.stdout.splitlines()
 
 
@@ -191,12 +191,26 @@ def test_make_lab_is_the_courses_and_make_test_runs_no_notebook(pack):
     assert (folder / sp.MARKER_NAME).read_text().count("make lab") == 1
 
 
+def test_the_packs_make_is_not_the_callers(pack, monkeypatch):
+    """The issue's case: ``make test PYTEST_ARGS=--durations=60`` failed the test above.
+
+    Make exports a variable given on its command line to every recipe and passes it on to
+    every make below it through MAKEFLAGS: a dry run of the pack's ``make test`` printed
+    the caller's options.
+    """
+    _, folder = pack
+    for name, value in {"MAKEFLAGS": r" -- PYTEST_ARGS=--durations=60\ -x", "MAKELEVEL": "1",
+                        "MAKEOVERRIDES": "${-*-command-variables-*-}",
+                        "PYTEST_ARGS": "--durations=60 -x"}.items():
+        monkeypatch.setenv(name, value)
+    assert dry_run(folder, "test")[-1].split()[1:] == ["-m", "pytest", "tests"]
+
+
 @pytest.mark.slow
 def test_the_packs_structure_tests_can_fail(pack, tmp_path):
     """A notebook with a worked solution left in, and a core task without its check."""
     _, folder = pack
-    copy = tmp_path / sp.PACK_NAME
-    shutil.copytree(folder, copy)
+    copy = writable_copy(folder, tmp_path / sp.PACK_NAME)
     conventions = json.loads((copy / "tests" / sp.CONVENTIONS_NAME).read_text("utf-8"))
     [name, *_] = conventions["checked_notebooks"] or pytest.fail("no question notebook")
     path = copy / "notebooks" / name
@@ -209,24 +223,27 @@ def test_the_packs_structure_tests_can_fail(pack, tmp_path):
     nbformat.write(notebook, path)
     result = subprocess.run([sys.executable, "-m", "pytest", f"tests/{sp.STRUCTURE_TEST}",
                              "-q", "-p", "no:cacheprovider"], cwd=copy, capture_output=True,
-                            text=True, timeout=600)
+                            text=True, timeout=600, env=make_environment())
     assert result.returncode == 1, result.stdout[-3000:]
     assert f"{name}, cell {first_task}: tags ['solution']" in result.stdout
     assert "no check follows this core task" in result.stdout
 
 
 @pytest.mark.slow
-def test_the_packs_make_test_passes_with_this_interpreter(pack):
+def test_the_packs_make_test_passes_with_this_interpreter(pack, tmp_path):
     """Its pytest command, run as ``make test`` runs it, with the current Python."""
-    _, folder = pack
+    _, packed = pack
+    folder = writable_copy(packed, tmp_path / sp.PACK_NAME)  # pytest writes caches there
     [command] = [line for line in dry_run(folder, "test") if " -m pytest" in line]
     argv = [sys.executable, *shlex.split(command)[1:], "-p", "no:cacheprovider", "-q"]
-    collected = subprocess.run([*argv, "--collect-only"], cwd=folder, capture_output=True,
-                               text=True, timeout=600)
-    assert collected.returncode == 0, collected.stdout[-3000:] + collected.stderr[-3000:]
     sample = " or ".join([sp.STRUCTURE_TEST.removesuffix(".py"), *SAMPLE_UNIT_TESTS])
-    result = subprocess.run([*argv, "-k", sample], cwd=folder, capture_output=True, text=True,
-                            timeout=600)
+    # One run: pytest collects every test (an error in any stops the run), then runs the
+    # sample; -rA lists each test that passed.
+    result = subprocess.run([*argv, "-k", sample, "-rA"], cwd=folder, capture_output=True,
+                            text=True, timeout=600, env=make_environment())
     assert result.returncode == 0, result.stdout[-5000:] + result.stderr[-3000:]
-    assert " passed" in result.stdout.splitlines()[-1]
-    assert "test_student_notebooks.py" in collected.stdout
+    last = result.stdout.splitlines()[-1]
+    assert " passed" in last and " deselected" in last, last
+    assert f"PASSED tests/{sp.STRUCTURE_TEST}::" in result.stdout, result.stdout[-3000:]
+    for name in SAMPLE_UNIT_TESTS:
+        assert f"PASSED tests/{name}.py::" in result.stdout, name

@@ -1,7 +1,8 @@
 """The handouts are accessible offline: typeset maths, described figures, axe-core clean.
 
-The handouts are built afresh from ``notebooks/`` (local MathJax, both variants) and
-every page is opened from disk in Chromium with the network cut, at 200 % zoom in the
+The handouts of ``notebooks/`` (local MathJax, both variants) are the run's one build,
+shared with every handout test (``handouts_build``, tests/artefacts.py), and every page is
+opened from disk in Chromium with the network cut, at 200 % zoom in the
 sense of WCAG 1.4.10 (a 640 CSS px wide viewport, two device pixels per CSS pixel).
 Once MathJax has finished, each page is checked for:
 
@@ -28,7 +29,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import pytest
-from lab_driver import NOTEBOOK_DIR, course_notebooks, screenshot_path
+from artefacts import HandoutsBuild
+from lab_driver import course_notebooks, screenshot_path
 from offline_pages import (
     FIREFOX_USER_AGENT,
     ZOOM_200_SCALE,
@@ -37,7 +39,7 @@ from offline_pages import (
 )
 
 from lqe_helpers.authoring.handout_pages import GENERIC_ALT
-from lqe_helpers.authoring.handouts import PROSE_DIR, build_handouts
+from lqe_helpers.authoring.handouts import PROSE_DIR
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(1800)]
 
@@ -156,9 +158,8 @@ def audit_page(browser, path: Path, root: Path, *, user_agent: str | None = None
 
 
 @pytest.fixture(scope="session")
-def handouts_dir(chromium_executable: str, tmp_path_factory: pytest.TempPathFactory) -> Path:
-    out_dir = tmp_path_factory.mktemp("handouts-a11y")
-    build_handouts(NOTEBOOK_DIR, out_dir)  # the default: MathJax copied into the folder
+def handouts_dir(chromium_executable: str, handouts_build: HandoutsBuild) -> Path:
+    out_dir = handouts_build.folder  # built with the default: MathJax copied into the folder
     assert (out_dir / "mathjax" / "MathJax.js").is_file()
     return out_dir
 

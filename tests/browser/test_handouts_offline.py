@@ -1,10 +1,10 @@
 """The HTML handouts work offline: every image loads with the network cut.
 
-The handouts are built afresh from ``notebooks/`` (with code, and the prose variant)
-and each page is opened from disk in Chromium with no network. Every image must load,
-nothing but the MathJax script the pages are built with (loaded asynchronously; the
-pages can do without it) may try to reach the network, and every link to a local
-page must exist.
+The handouts of ``notebooks/`` (with code, and the prose variant) are the run's one
+build, shared with every handout test (``handouts_build``, tests/artefacts.py), and each
+page is opened from disk in Chromium with no network. Every image must load, nothing but
+the MathJax script the pages are built with (loaded asynchronously; the pages can do
+without it) may try to reach the network, and every link to a local page must exist.
 """
 
 from __future__ import annotations
@@ -13,21 +13,21 @@ from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
 import pytest
-from lab_driver import NOTEBOOK_DIR, course_notebooks, screenshot_path
+from artefacts import HandoutsBuild
+from lab_driver import course_notebooks, screenshot_path
 from offline_pages import OfflinePage, open_offline
 
-from lqe_helpers.authoring.handouts import DEFAULT_MATHJAX_URL, build_handouts
+from lqe_helpers.authoring.handouts import build_handouts
 
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(600)]
 
 
 @pytest.fixture(scope="session")
-def handout_pages(chromium_executable: str, tmp_path_factory: pytest.TempPathFactory
-                  ) -> list[Path]:
-    out_dir = tmp_path_factory.mktemp("handouts")
-    written = build_handouts(NOTEBOOK_DIR, out_dir, mathjax_url=DEFAULT_MATHJAX_URL)
-    found = sorted(out_dir.rglob("*.html"))
-    assert sorted(written) == found, "build_handouts did not list every page it wrote"
+def handout_pages(chromium_executable: str, handouts_build: HandoutsBuild) -> list[Path]:
+    """Every page of the run's handouts (built with the default, local MathJax)."""
+    found = sorted(handouts_build.folder.rglob("*.html"))
+    assert sorted(handouts_build.pages) == found, (
+        "build_handouts did not list every page it wrote")
     return found
 
 
@@ -64,6 +64,7 @@ def test_every_handout_image_loads_offline(browser, handout_pages: list[Path]) -
 SPACED_NAMES = ["01 first page", "02 café ΔΣ", "03 #hash?"]
 
 
+@pytest.mark.kernel
 def test_pages_named_with_spaces_and_accents_open_from_the_index(browser, tmp_path: Path
                                                                 ) -> None:
     import nbformat
