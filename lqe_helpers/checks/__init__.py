@@ -16,8 +16,10 @@ the student's value with :func:`judging.judge` against a catalogue of likely mis
 One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
 every ``check_…`` and the tolerances:
 
-- ``background`` (00), ``vision`` (01, with ``filter_models``), ``initial_covariance``
-  (02), ``fusion`` (03), ``noisier_proprioception`` (04), ``delay`` (05), ``bias`` (06);
+- ``background`` (00; its Going further in ``background_further`` and
+  ``background_jerk_choice``), ``vision`` (01, with ``filter_models``),
+  ``initial_covariance`` (02), ``fusion`` (03), ``noisier_proprioception`` (04),
+  ``delay`` (05), ``bias`` (06);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -25,7 +27,22 @@ every ``check_…`` and the tolerances:
 - ``numbers``: the number checks several notebooks share until they have their own.
 """
 
-from .background import check_covariance_step, check_transition_matrix
+from .background import (
+    check_covariance_step,
+    check_eyes_closed,
+    check_jerk_matching,
+    check_transition_matrix,
+)
+from .background_further import (
+    check_one_step_error,
+    check_uncertainty_growth,
+    check_white_jerk,
+)
+from .background_jerk_choice import (
+    check_jerk_from_readings,
+    check_jerk_sweep,
+    check_sweep_reading,
+)
 from .bias import check_bias_model
 from .delay import check_compensation, check_delay_difference, check_delay_mse
 from .fusion import check_fusion
@@ -56,12 +73,20 @@ __all__ = [
     "check_covariance_step",
     "check_delay_difference",
     "check_delay_mse",
+    "check_eyes_closed",
     "check_filter",
     "check_fusion",
     "check_initial_covariance",
+    "check_jerk_from_readings",
+    "check_jerk_matching",
+    "check_jerk_sweep",
     "check_mse",
+    "check_one_step_error",
     "check_paired_difference",
+    "check_sweep_reading",
     "check_transition_matrix",
+    "check_uncertainty_growth",
     "check_vision_difference",
     "check_vision_mse",
+    "check_white_jerk",
 ]
