@@ -11,6 +11,7 @@ Nothing runs on import.
 """
 
 from .background import (
+    jerk_choice_figure,
     jerk_sweep_figure,
     mse_intervals_figure,
     open_loop_figure,
@@ -41,6 +42,7 @@ __all__ = [
     "acceleration_signal_figure", "assumed_noise_figure", "belief_and_error_figure",
     "bias_learning_figure", "bias_settling_figure", "delay_figure", "delay_sweep_figure",
     "drift_figure", "estimate_error_figure", "fusion_trial_figure", "gains_figure",
+    "jerk_choice_figure",
     "jerk_sweep_figure", "mse_intervals_figure", "noise_sweep_figure", "open_loop_figure",
     "p0_sweep_figure", "paired_mse_figure", "prediction_error_sources_figure",
     "proprioception_sweep_figure", "squared_error_figure", "start_up_figure",
