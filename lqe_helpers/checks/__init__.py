@@ -19,7 +19,7 @@ every ``check_…`` and the tolerances:
 - ``background`` (00; its Going further in ``background_further`` and
   ``background_jerk_choice``), ``vision`` (01, with ``filter_models``),
   ``initial_covariance`` (02), ``fusion`` (03), ``noisier_proprioception`` (04),
-  ``delay`` (05), ``bias`` (06);
+  ``delay`` (05), ``bias`` (06, its Going further in ``bias_further``);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -43,7 +43,13 @@ from .background_jerk_choice import (
     check_jerk_sweep,
     check_sweep_reading,
 )
-from .bias import check_bias_model
+from .bias import check_bias_model, check_signal_worth
+from .bias_further import (
+    check_bias_and_vision,
+    check_bias_precision,
+    check_dead_reckoning,
+    check_sigma_a_sweep,
+)
 from .delay import check_compensation, check_delay_difference, check_delay_mse
 from .fusion import check_fusion
 from .initial_covariance import check_convergence_time, check_initial_covariance
@@ -67,10 +73,13 @@ __all__ = [
     "SEED",
     "TIME_ATOL",
     "CheckFailed",
+    "check_bias_and_vision",
     "check_bias_model",
+    "check_bias_precision",
     "check_compensation",
     "check_convergence_time",
     "check_covariance_step",
+    "check_dead_reckoning",
     "check_delay_difference",
     "check_delay_mse",
     "check_eyes_closed",
@@ -83,6 +92,8 @@ __all__ = [
     "check_mse",
     "check_one_step_error",
     "check_paired_difference",
+    "check_sigma_a_sweep",
+    "check_signal_worth",
     "check_sweep_reading",
     "check_transition_matrix",
     "check_uncertainty_growth",
