@@ -53,3 +53,48 @@ def test_check_bias_model_names_a_bad_argument():
                  np.nan, SIGMA_A)
     assert_fails("Q must be the process noise covariance, an array of shape (3, 3), got values "
                  "too large to square", checks.check_bias_model, F, G, Q * 1e300, DT, SIGMA_A)
+
+
+# --- check_signal_worth (Task 2) ------------------------------------------------------------
+
+def signal_worth(*, mistake=""):
+    """with_vs_without of Task 2, as a student writes it, with one slip at most."""
+    from lqe_helpers import experiments, metrics
+    from lqe_helpers.scenario import DEFAULT
+
+    mc = bias_model.track_with_input(DEFAULT, runs=DEFAULT.mc_runs)
+    vision_only = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    with_signal = mc.dead_reckoning_mse() if mistake == "dead reckoning" else mc.mse()
+    alone = vision_only.mse()
+    if mistake == "reversed":
+        return metrics.mean_ci95(alone - with_signal)
+    if mistake == "percent":
+        return metrics.mean_ci95(100 * (with_signal - alone) / alone.mean())
+    if mistake == "whole trial":
+        truth = DEFAULT.truth[:, 0]
+        return metrics.mean_ci95(metrics.mse(mc.positions, truth)
+                                 - metrics.mse(vision_only.positions, truth))
+    if mistake == "one vision run":
+        return metrics.mean_ci95(with_signal - float(experiments.track(DEFAULT).mse()))
+    return metrics.mean_ci95(with_signal - alone)
+
+
+def test_check_signal_worth_passes_the_worked_solution(capsys):
+    line = assert_passes(capsys, checks.check_signal_worth, signal_worth())
+    assert "300 runs" in line
+
+
+@pytest.mark.parametrize(("mistake", "phrase"), [
+    ("reversed", "the sign is reversed"),
+    ("percent", "it is in % of the vision-only MSE"),
+    ("whole trial", "of the whole trial"),
+    ("dead reckoning", "dead reckoning's MSE"),
+    ("one vision run", "a single run"),
+])
+def test_check_signal_worth_names_each_realistic_mistake(mistake, phrase):
+    assert_fails(phrase, checks.check_signal_worth, signal_worth(mistake=mistake))
+
+
+def test_check_signal_worth_wants_the_interval():
+    interval = signal_worth()
+    assert_fails("it must be the metrics.Interval", checks.check_signal_worth, interval.mean)

@@ -16,12 +16,13 @@ the student's value with :func:`judging.judge` against a catalogue of likely mis
 One module per notebook, as in :mod:`lqe_helpers.explorers`; this package re-exports
 every ``check_…`` and the tolerances:
 
-- ``background`` (00), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
+- ``background`` (00; its Going further in ``background_further`` and
+  ``background_jerk_choice``), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
   ``vision_further`` for its Going further), ``initial_covariance`` (02, with
   ``initial_covariance_further``), ``fusion`` (03, with ``fusion_further``),
   ``noisier_proprioception`` (04, with ``misjudged_noise``), ``delay`` (05, with
   ``compensation_cases``; its Going further in ``delay_sweep`` and ``delay_further``),
-  ``bias`` (06);
+  ``bias`` (06; its Going further in ``bias_further``);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
@@ -29,8 +30,29 @@ every ``check_…`` and the tolerances:
 - ``numbers``: the number checks several notebooks share until they have their own.
 """
 
-from .background import check_covariance_step, check_transition_matrix
-from .bias import check_bias_model
+from .background import (
+    check_covariance_step,
+    check_eyes_closed,
+    check_jerk_matching,
+    check_transition_matrix,
+)
+from .background_further import (
+    check_one_step_error,
+    check_uncertainty_growth,
+    check_white_jerk,
+)
+from .background_jerk_choice import (
+    check_jerk_from_readings,
+    check_jerk_sweep,
+    check_jerk_sweep_reading,
+)
+from .bias import check_bias_model, check_signal_worth
+from .bias_further import (
+    check_bias_and_vision,
+    check_bias_precision,
+    check_dead_reckoning,
+    check_sigma_a_sweep,
+)
 from .delay import check_compensation, check_delay_difference, check_delay_mse
 from .delay_further import check_late_eye, check_short_delays
 from .delay_sweep import (
@@ -102,17 +124,21 @@ __all__ = [
     "TIME_ATOL",
     "CheckFailed",
     "check_assumed_sweep",
+    "check_bias_and_vision",
     "check_bias_model",
+    "check_bias_precision",
     "check_compensation",
     "check_compensation_regimes",
     "check_convergence_intervals",
     "check_convergence_times",
     "check_covariance_step",
+    "check_dead_reckoning",
     "check_delay_difference",
     "check_delay_mse",
     "check_delay_sweep",
     "check_equivalent_sensor",
     "check_error_sources",
+    "check_eyes_closed",
     "check_filter",
     "check_first_gains",
     "check_flight_scales",
@@ -123,6 +149,10 @@ __all__ = [
     "check_halving",
     "check_initial_covariance",
     "check_initial_covariances",
+    "check_jerk_from_readings",
+    "check_jerk_matching",
+    "check_jerk_sweep",
+    "check_jerk_sweep_reading",
     "check_late_eye",
     "check_misjudged",
     "check_misjudged_nis",
@@ -132,6 +162,7 @@ __all__ = [
     "check_noisier_difference",
     "check_noisier_theory",
     "check_noisier_trial",
+    "check_one_step_error",
     "check_overconfidence",
     "check_p0_sweep",
     "check_paired_difference",
@@ -141,6 +172,8 @@ __all__ = [
     "check_settled_filter",
     "check_settled_variances",
     "check_short_delays",
+    "check_sigma_a_sweep",
+    "check_signal_worth",
     "check_smoother",
     "check_smoother_comparison",
     "check_start_and_after",
@@ -149,6 +182,8 @@ __all__ = [
     "check_sweep_reading",
     "check_systematic_error",
     "check_transition_matrix",
+    "check_uncertainty_growth",
     "check_vision_difference",
     "check_vision_mse",
+    "check_white_jerk",
 ]

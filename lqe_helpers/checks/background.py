@@ -1,16 +1,33 @@
-"""Checks of notebook 00, the background: A of eq. (4) and the covariance step of eq. (9)."""
+"""Checks of notebook 00, the background: the core tasks.
+
+- :func:`check_transition_matrix` (Task 1): the student's ``A(dt)`` of eq. (4);
+- :func:`check_eyes_closed` (Task 2): the student's covariance step of Lesson 0.5 eq. (9),
+  then the 2σ band it grows from the filter's covariance at t = 2 s and when it first
+  exceeds the flight's amplitude, recomputed with the engine;
+- :func:`check_jerk_matching` (Task 3): σ_j matched over four time scales, the Monte Carlo
+  MSE of each and the paired whole − quarter difference, recomputed with the engine.
+
+The Going further tasks are checked in :mod:`lqe_helpers.checks.background_further`.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import functools
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from .. import model
+from .. import experiments, metrics, model
+from ..prediction import propagate_covariance
+from ..scenario import DEFAULT, matched_jerk_std
+from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
+    INTERVAL_RTOL,
     MATRIX_RTOL,
+    MSE_RTOL,
     SEED,
+    TIME_ATOL,
     CheckFailed,
     call_student,
     close,
@@ -164,7 +181,15 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
         wrong shape, or another matrix; typical mistakes are named (F on the wrong
         sides, no noise term, σ instead of σ², no transpose, P not moved by F).
     """
-    name = require_callable(predict_covariance, "predict_covariance", "check_covariance_step")
+    name = _judge_covariance_step(predict_covariance, "check_covariance_step")
+    passed(f"{name} gives F P Fᵀ + G σ² Gᵀ (Lesson 0.5 eq. (9)) on "
+           f"{len(_COVARIANCE_CASES)} random cases (1–4 states, 1–2 inputs), to "
+           f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}")
+
+
+def _judge_covariance_step(predict_covariance: Callable[..., np.ndarray], check: str) -> str:
+    """The student's function's name if it follows eq. (9) on every case, else CheckFailed."""
+    name = require_callable(predict_covariance, "predict_covariance", check)
     cases = _covariance_cases()
     right = [F @ P @ F.T + sigma**2 * G @ G.T for P, F, G, sigma in cases]
     wrong = []
@@ -182,10 +207,7 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
         if not close(array, expected, MATRIX_RTOL):
             wrong.append((array, P, F, G, sigma, where))
     if not wrong:
-        passed(f"{name} gives F P Fᵀ + G σ² Gᵀ (Lesson 0.5 eq. (9)) on "
-               f"{len(_COVARIANCE_CASES)} random cases (1–4 states, 1–2 inputs), to "
-               f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}")
-        return
+        return name
     for key in ("sides", "no_noise", "sigma", "no_transpose", "not_moved"):
         if all(close(array, _covariance_mistakes(P, F, G, sigma)[key][0], MATRIX_RTOL)
                for array, P, F, G, sigma, _ in wrong):
@@ -194,3 +216,245 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
     raise CheckFailed(
         f"{name} does not give F P Fᵀ + G σ² Gᵀ on {wrong[0][5]}, and not by one of the "
         f"usual mistakes")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 2: eyes closed
+# ------------------------------------------------------------------------------------------
+
+#: When the eyes close in Task 2 (s), and how many steps of 0.01 s they stay closed.
+EYES_CLOSE_TIME = 2.0
+EYES_CLOSED_STEPS = 100
+
+
+@functools.cache
+def _eyes_closed() -> dict[str, object]:
+    """Task 2's right band (101,) (cm) and crossing (s), and the likely wrong bands."""
+    result = experiments.track(DEFAULT).result
+    close_at = round(EYES_CLOSE_TIME / DEFAULT.dt)
+    P_close = result.estimate_covariances[close_at]
+    g = model.jerk_input_matrix(DEFAULT.dt)
+    sigma_j = DEFAULT.process_jerk_std
+
+    def variance(start: np.ndarray, jerk_variance: float) -> np.ndarray:
+        Q = jerk_variance * g @ g.T
+        return propagate_covariance(start, DEFAULT.A, Q, EYES_CLOSED_STEPS)[:, 0, 0]
+
+    right = variance(P_close, sigma_j**2)
+    bands = {
+        "it is σ, not 2σ: double the standard deviation": np.sqrt(right),
+        "it is twice the variance: take the square root of P[0, 0] (the standard deviation, "
+        "cm), then double it": 2 * right,
+        "it is the variance P[0, 0] itself (cm²): 2σ is twice its square root (cm)": right,
+        "the 2 is inside the square root (√(2 P[0, 0])): 2σ is 2 √(P[0, 0])":
+            np.sqrt(2 * right),
+        "sigma was given the jerk's variance σ_j² where its standard deviation σ_j belongs "
+        "(predict_covariance squares it)": 2 * np.sqrt(variance(P_close, sigma_j**4)),
+        "it starts from P = 0, a perfectly known state; the band starts from P_close, the "
+        "filter's own covariance when the eyes close":
+            2 * np.sqrt(variance(np.zeros((3, 3)), sigma_j**2)),
+        "it starts from the filter's prediction covariance at t = 2 s (before the reading "
+        "of that sample); start from P_close, the covariance of its estimate":
+            2 * np.sqrt(variance(result.covariances[close_at], sigma_j**2)),
+    }
+    two_sigma = 2 * np.sqrt(right)
+    above = int(np.argmax(two_sigma > DEFAULT.amplitude))
+    return {"two_sigma": two_sigma, "bands": bands, "crossing": above * DEFAULT.dt,
+            "steps": above}
+
+
+def check_eyes_closed(predict_covariance: Callable[..., np.ndarray], two_sigma: object,
+                      crossing: object) -> None:
+    """Check Task 2: the covariance step, the 2σ band it grows and when the band passes A.
+
+    First ``predict_covariance`` is checked as by :func:`check_covariance_step` (five
+    random cases, :data:`MATRIX_RTOL`). Then, recomputed from the task's inputs before
+    looking at the student's: the vision-only filter's estimate covariance at t = 2 s of
+    the scenario's draw (``P_close``), carried 100 steps by
+    :func:`lqe_helpers.prediction.propagate_covariance` with ``DEFAULT.A`` and
+    ``DEFAULT.Q``; ``two_sigma`` (101 values, cm) must agree within :data:`MATRIX_RTOL`
+    relative, and ``crossing``, the first time after the eyes close at which 2σ exceeds
+    the amplitude (s), within :data:`TIME_ATOL`.
+
+    Parameters
+    ----------
+    predict_covariance : callable
+        The student's ``predict_covariance(P, F, G, sigma)``.
+    two_sigma : array_like, shape (101,)
+        Twice the standard deviation of the position (cm) at 0, 0.01, …, 1 s after the
+        eyes close.
+    crossing : float
+        The first time (s after the eyes close) at which it exceeds the amplitude.
+
+    Raises
+    ------
+    CheckFailed
+        With the likely cause: the function's mistake, σ instead of 2σ, the variance,
+        σ_j² given as sigma, the band started from P = 0, 100 values instead of 101,
+        the crossing in samples, a step early, counted from the start of the trial, ...
+    """
+    name = _judge_covariance_step(predict_covariance, "check_eyes_closed")
+    right = _eyes_closed()
+    expected = right["two_sigma"]
+    try:
+        shape = np.shape(two_sigma)
+    except ValueError:  # a ragged list: judge names it
+        shape = None
+    if shape == (EYES_CLOSED_STEPS,):
+        raise CheckFailed(
+            f"two_sigma has {EYES_CLOSED_STEPS} values; keep the moment the eyes close too "
+            f"(two_sigma[0], from P_close itself), then one value per step: "
+            f"{EYES_CLOSED_STEPS + 1} in all")
+    judge("two_sigma", two_sigma, expected, MATRIX_RTOL, unit="cm",
+          what="2σ of the position recomputed from P_close with the engine",
+          mistakes=right["bands"])
+    dt, steps = DEFAULT.dt, right["steps"]
+    judge("crossing", crossing, right["crossing"], TIME_ATOL,
+          unit="s", what="the first time 2σ exceeds the amplitude, recomputed",
+          mistakes={
+              "it is in samples; multiply by Δt to get seconds": steps,
+              "it is one step early: the last time 2σ is still below the amplitude; the task "
+              "asks for the first time it is above": (steps - 1) * dt,
+              "it is one step late: take the first sample above the amplitude":
+                  (steps + 1) * dt,
+              f"it counts from the start of the trial; count from the moment the eyes close "
+              f"(t = {EYES_CLOSE_TIME:g} s)": steps * dt + EYES_CLOSE_TIME,
+          })
+    passed(f"{name} follows eq. (9) on {len(_COVARIANCE_CASES)} random cases, and two_sigma "
+           f"and crossing match the band grown from P_close by the pack's engine (to "
+           f"{tolerance_text(MATRIX_RTOL)} relative and {tolerance_text(TIME_ATOL)} s)")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 3: which time scale for σ_j?
+# ------------------------------------------------------------------------------------------
+
+#: Task 3's matching times T, as fractions of the flight's period, by the names the
+#: notebook's ``periods`` dict uses.
+PERIODS = {"an eighth": 1 / 8, "a quarter": 1 / 4, "a half": 1 / 2, "a whole": 1.0}
+
+
+def _named(values: object, name: str, what: str) -> dict[str, object]:
+    """The student's dict with one entry per name of :data:`PERIODS`."""
+    if not isinstance(values, Mapping):
+        found = "None" if values is None else f"a {type(values).__name__}"
+        raise CheckFailed(f"{name} must be a dict of {what} keyed by the names of periods "
+                          f"({', '.join(repr(key) for key in PERIODS)}), got {found}")
+    missing = [key for key in PERIODS if key not in values]
+    if missing:
+        have = ", ".join(repr(key) for key in values) or "none"
+        raise CheckFailed(f"{name} has no entry {missing[0]!r} (its keys: {have}); use the "
+                          f"names of periods as keys")
+    return {key: values[key] for key in PERIODS}
+
+
+def _sigma_mistakes(fraction: float) -> dict[str, float]:
+    """σ_j (cm/s³) with the usual slips of A ω² / √(Δt T), T = fraction / f."""
+    a, f, dt = DEFAULT.amplitude, DEFAULT.frequency, DEFAULT.dt
+    omega, T = 2 * np.pi * f, fraction / f
+    return {
+        "T is in periods, not seconds: T = (fraction of a period) / f": a * omega**2
+        / np.sqrt(dt * fraction),
+        "the period was taken as f; it is 1/f (2 s), so T = (fraction of a period) / f":
+            a * omega**2 / np.sqrt(dt * fraction * f),
+        "ω is f (Hz) where the angular frequency ω = 2πf (rad/s) belongs":
+            a * f**2 / np.sqrt(dt * T),
+        "ω is not squared: A ω is the peak speed; the peak acceleration is A ω²":
+            a * omega / np.sqrt(dt * T),
+        "it uses A ω³, the peak jerk; the acceleration's swing is A ω²":
+            a * omega**3 / np.sqrt(dt * T),
+        "the square root is missing: the spread of the random walk is σ_j √(Δt T)":
+            a * omega**2 / (dt * T),
+        "Δt is missing under the root: the random walk's spread after T is σ_j √(Δt T)":
+            a * omega**2 / np.sqrt(T),
+    }
+
+
+@functools.cache
+def _matching_runs() -> dict[str, dict[str, np.ndarray]]:
+    """Per-run MSEs (runs,) of each matching time, with what the usual slips give."""
+    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
+    noise = DEFAULT.unit_noise(DEFAULT.mc_runs, ("vision",))  # the task's draw, drawn once
+    default = experiments.track(DEFAULT, runs=DEFAULT.mc_runs, noise=noise)
+    found = {}
+    for key, fraction in PERIODS.items():
+        sigma = matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency, dt, fraction)
+        batch = experiments.track(dataclasses.replace(DEFAULT, jerk_std=sigma),
+                                  runs=DEFAULT.mc_runs, noise=noise)
+        found[key] = {"sigma": sigma, "mse": batch.mse(),
+                      "whole": metrics.mse(batch.positions, truth),
+                      "mistakes": {
+                          "every run used the pack's σ_j: make a Scenario with this σ_j "
+                          "(dataclasses.replace(DEFAULT, jerk_std=…)) for the filter":
+                              default.mse(),
+                          "it is the MSE of the raw readings, not of the filtered "
+                          "estimate": batch.measurement_mse("vision"),
+                          **mse_mistakes(batch.positions, truth, burn, dt)}}
+    return found
+
+
+def check_jerk_matching(jerk_stds: Mapping[str, float], mse_runs: Mapping[str, np.ndarray],
+                        whole_vs_quarter: metrics.Interval) -> None:
+    """Check Task 3: σ_j for four matching times, their Monte Carlo MSEs, whole − quarter.
+
+    Recomputed from the task's inputs before looking at the student's: σ_j = A ω² /
+    √(Δt T) for T = 1/8, 1/4, 1/2 and 1 period (:func:`lqe_helpers.scenario.matched_jerk_std`,
+    within :data:`MATRIX_RTOL` relative), the per-run MSEs after the burn-in of
+    ``DEFAULT.mc_runs`` runs of the vision-only filter with each (the pack's engine,
+    :func:`lqe_helpers.experiments.track`, within :data:`MSE_RTOL` relative), and
+    ``metrics.mean_ci95`` of the per-run differences whole − quarter (within
+    :data:`INTERVAL_RTOL` of the interval's scale).
+
+    Parameters
+    ----------
+    jerk_stds : dict of str to float
+        σ_j (cm/s³) keyed "an eighth", "a quarter", "a half", "a whole".
+    mse_runs : dict of str to ndarray, shape (runs,)
+        Per-run MSEs (cm²), same keys.
+    whole_vs_quarter : metrics.Interval
+        Paired mean of MSE(whole) − MSE(quarter) with its 95 % interval (cm²).
+
+    Raises
+    ------
+    CheckFailed
+        Naming the entry and the likely cause: T in periods instead of seconds, ω = f,
+        ω not squared, no square root; the pack's σ_j for every T, the whole trial, one
+        MSE instead of the per-run values; the difference the wrong way round, unpaired,
+        in %, ...
+    """
+    sigmas = _named(jerk_stds, "jerk_stds", "σ_j values (cm/s³)")
+    mses = _named(mse_runs, "mse_runs", "per-run MSEs (cm², shape (runs,))")
+    runs = _matching_runs()
+    for key, fraction in PERIODS.items():
+        judge(f"jerk_stds[{key!r}]", sigmas[key], runs[key]["sigma"], MATRIX_RTOL,
+              unit="cm/s³", what="A ω² / √(Δt T) recomputed for this T",
+              mistakes=_sigma_mistakes(fraction))
+    for key in PERIODS:
+        value = mses[key]
+        if np.ndim(value) == 0:
+            raise CheckFailed(
+                f"mse_runs[{key!r}] is one number; keep the per-run MSEs (.mse() of the "
+                f"{DEFAULT.mc_runs} runs, shape ({DEFAULT.mc_runs},)), so that the runs can "
+                f"be paired")
+        mistakes = dict(runs[key]["mistakes"])
+        if key == "a quarter":  # the pack's σ_j is the quarter's: not a mistake here
+            mistakes = {cause: v for cause, v in mistakes.items() if "pack's σ_j" not in cause}
+        judge(f"mse_runs[{key!r}]", value, runs[key]["mse"], MSE_RTOL, unit="cm²",
+              what="the per-run MSEs recomputed with the engine", mistakes=mistakes)
+    whole, quarter = runs["a whole"]["mse"], runs["a quarter"]["mse"]
+    percent = 100 / quarter.mean()
+    judge_interval(
+        "whole_vs_quarter", whole_vs_quarter, metrics.mean_ci95(whole - quarter),
+        INTERVAL_RTOL, unit="cm²",
+        what="the paired difference whole − quarter recomputed from the task's inputs",
+        mistakes={
+            **interval_mistakes(whole, quarter, "the whole period's MSE", "the quarter's MSE"),
+            "it is in % of the quarter's MSE; the task asks for the difference in cm²":
+                metrics.mean_ci95(percent * (whole - quarter)),
+            "the MSEs are those of the whole trial: leave out the burn-in in both":
+                metrics.mean_ci95(runs["a whole"]["whole"] - runs["a quarter"]["whole"]),
+        })
+    passed(f"σ_j for T = 1/8, 1/4, 1/2 and 1 period (to {tolerance_text(MATRIX_RTOL)}), the "
+           f"per-run MSEs of {DEFAULT.mc_runs} runs with each (to {tolerance_text(MSE_RTOL)}) "
+           f"and the paired whole − quarter interval (to {tolerance_text(INTERVAL_RTOL)}) "
+           f"match the pack's engine on the scenario's draws")

@@ -1,11 +1,23 @@
-"""Checks of notebook 06, the bonus: F, G and Q of the biased acceleration model."""
+"""Checks of notebook 06, the bonus: the core tasks.
+
+- :func:`check_bias_model` (Task 1): F, G and Q of the biased acceleration model;
+- :func:`check_signal_worth` (Task 2): the paired MSE difference with − without the
+  signal, recomputed with :mod:`lqe_helpers.bias_model` and the engine.
+
+The Going further tasks are checked in :mod:`lqe_helpers.checks.bias_further`.
+"""
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
-from .. import bias_model
+from .. import bias_model, experiments, metrics
+from ..scenario import DEFAULT
+from .judging import interval_mistakes, judge_interval
 from .machinery import (
+    INTERVAL_RTOL,
     MATRIX_RTOL,
     CheckFailed,
     argument_array,
@@ -99,3 +111,54 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
         raise CheckFailed("Q is not G σ_a² Gᵀ (Lesson 0.5 eq. (9)) for the given σ_a")
     passed(f"F, G and Q = G σ_a² Gᵀ match Lesson 0.5 eqs. (5), (9) for Δt = {dt:g} s and "
            f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")
+
+
+@functools.cache
+def _signal_worth() -> dict[str, object]:
+    """Task 2's paired interval (cm²), recomputed, with the usual wrong ones."""
+    truth = DEFAULT.truth[:, 0]
+    with_signal = bias_model.track_with_input(DEFAULT, runs=DEFAULT.mc_runs)
+    vision = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    first, second = with_signal.mse(), vision.mse()
+    return {
+        "right": metrics.mean_ci95(first - second),
+        "mistakes": {
+            **interval_mistakes(first, second, "the MSE with the signal",
+                                "the vision-only MSE"),
+            "it is in % of the vision-only MSE; the task asks for the difference in cm²":
+                metrics.mean_ci95(100 * (first - second) / second.mean()),
+            "the MSEs are those of the whole trial: leave out the burn-in in both":
+                metrics.mean_ci95(metrics.mse(with_signal.positions, truth)
+                                  - metrics.mse(vision.positions, truth)),
+            "it uses dead reckoning's MSE (the signal integrated without vision), not the "
+            "filter's (mc.mse())": metrics.mean_ci95(with_signal.dead_reckoning_mse() - second),
+            f"the vision-only runs are a single run, not {DEFAULT.mc_runs} runs paired with "
+            f"the signal's": metrics.mean_ci95(first - float(experiments.track(DEFAULT).mse())),
+        },
+    }
+
+
+def check_signal_worth(with_vs_without: metrics.Interval) -> None:
+    """Check Task 2: the paired MSE difference with the signal − vision only (cm²).
+
+    Recomputed from the task's inputs before looking at the student's: the
+    ``DEFAULT.mc_runs`` runs of :func:`lqe_helpers.bias_model.track_with_input` at the
+    default bias and σ_a, and as many runs of the vision-only filter
+    (:func:`lqe_helpers.experiments.track`) on the same camera noise; ``metrics.mean_ci95``
+    of the per-run MSE differences after the burn-in, within :data:`INTERVAL_RTOL` of the
+    interval's scale.
+
+    Raises
+    ------
+    CheckFailed
+        With the likely cause: the difference the wrong way round, unpaired, in %, over
+        the whole trial, dead reckoning's MSE for the filter's, ...
+    """
+    right = _signal_worth()
+    judge_interval("with_vs_without", with_vs_without, right["right"], INTERVAL_RTOL,
+                   unit="cm²", what="the paired difference with − without the signal, "
+                                    "recomputed from the task's inputs",
+                   mistakes=right["mistakes"])
+    passed(f"with − without the signal, paired over {DEFAULT.mc_runs} runs: mean and 95 % "
+           f"interval match the pack's engine on the task's draws to "
+           f"{tolerance_text(INTERVAL_RTOL)} relative")

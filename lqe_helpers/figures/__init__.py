@@ -11,6 +11,7 @@ Nothing runs on import.
 """
 
 from .background import (
+    jerk_choice_figure,
     jerk_sweep_figure,
     mse_intervals_figure,
     open_loop_figure,
@@ -50,6 +51,7 @@ __all__ = [
     "frequency_response_figure",
     "fusion_trial_figure",
     "gains_figure",
+    "jerk_choice_figure",
     "jerk_sweep_figure",
     "lag_figure",
     "mse_intervals_figure",

@@ -5,9 +5,16 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import NullFormatter
 
 from ..plotting import COLORS, style
-from .common import errorbar_intervals, interval_arrays, label_axes, plot_series
+from .common import (
+    errorbar_intervals,
+    interval_arrays,
+    label_axes,
+    plain_log_ticks,
+    plot_series,
+)
 
 
 def open_loop_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
@@ -233,5 +240,74 @@ def tracking_panels_figure(times: np.ndarray, truth: np.ndarray, readings: np.nd
         label_axes(ax, "time (s)", xlim=(start, end))
     label_axes(axes[0, 0], ylabel="position (cm)",
                legend={"loc": "lower left", "fontsize": 8, "markerscale": 3})
+    fig.tight_layout()
+    return fig
+
+
+#: Line role and style of each way to choose σ_j in :func:`jerk_choice_figure` (told
+#: apart by line style as well as by colour).
+CHOICE_ROLES = {"likelihood": ("estimate", "-"), "NIS": ("prediction", "--"),
+                "MSE": ("truth", ":")}
+
+
+def jerk_choice_figure(jerk_stds: np.ndarray, log_likelihood: np.ndarray,
+                       nis_mean: np.ndarray, mse: np.ndarray, chosen: dict[str, float],
+                       expected_nis: float = 1.0) -> Figure:
+    """Three ways to choose σ_j on one grid: the innovations' likelihood, the NIS, the MSE.
+
+    Parameters
+    ----------
+    jerk_stds : array_like, shape (g,)
+        The grid of σ_j (cm/s³), > 0, increasing.
+    log_likelihood : array_like, shape (g,)
+        Mean log-likelihood of the innovations per run (nats); drawn relative to its
+        largest value.
+    nis_mean : array_like, shape (g,)
+        Mean NIS; drawn beside ``expected_nis``.
+    mse : array_like, shape (g,)
+        Mean position MSE (cm²), which needs the true path.
+    chosen : dict of str to float
+        The σ_j (cm/s³) each criterion picks, keyed by "likelihood", "NIS" and "MSE"
+        (:data:`CHOICE_ROLES`); each is a vertical line in every panel.
+    expected_nis : float
+        The mean NIS a correct model predicts (the number of sensors).
+
+    Returns
+    -------
+    Figure
+        Three panels sharing the log σ_j axis: likelihood, NIS, MSE.
+    """
+    jerk_stds = np.asarray(jerk_stds, dtype=float)
+    curves = [np.asarray(values, dtype=float) for values in (log_likelihood, nis_mean, mse)]
+    if any(curve.shape != jerk_stds.shape for curve in curves):
+        raise ValueError(f"log_likelihood, nis_mean and mse must have the grid's shape "
+                         f"{jerk_stds.shape}, got {[curve.shape for curve in curves]}")
+    unknown = set(chosen) - set(CHOICE_ROLES)
+    if unknown:
+        raise ValueError(f"chosen must be keyed by {tuple(CHOICE_ROLES)}, got {sorted(unknown)}")
+    likelihood, nis, mse = curves
+    fig, axes = plt.subplots(3, 1, figsize=(9, 7.5), sharex=True)
+    panels = [
+        (likelihood - likelihood.max(), "estimate", "log-likelihood − its largest (nats)",
+         "Readings alone: the innovations' log-likelihood (mean per run)"),
+        (nis, "prediction", "mean NIS", "Readings alone: the mean NIS"),
+        (mse, "truth", "MSE (cm²)", "With the true path: the MSE after 1 s"),
+    ]
+    for ax, (values, role, ylabel, title) in zip(axes, panels, strict=True):
+        ax.plot(jerk_stds, values, **style(role, marker="o", markersize=3))
+        for key, value in chosen.items():
+            role, linestyle = CHOICE_ROLES[key]
+            ax.axvline(value, **style(role, linestyle=linestyle, linewidth=1.2,
+                                      label=f"chosen by {key}: {value:,.0f} cm/s³"))
+        label_axes(ax, ylabel=ylabel, title=title, xscale="log")
+        ax.title.set_fontsize(10)
+    axes[1].axhline(expected_nis, color=COLORS["reference"], linewidth=1.2,
+                    label=f"expected mean NIS ({expected_nis:g})")
+    label_axes(axes[-1], "jerk noise σ_j behind Q (cm/s³)")
+    low, high = jerk_stds.min(), jerk_stds.max()
+    plain_log_ticks(axes[-1], "x", [tick for tick in (500, 700, 1000, 1400, 2000, 2800, 4000)
+                                    if low <= tick <= high] or None)
+    axes[-1].xaxis.set_minor_formatter(NullFormatter())
+    axes[1].legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     return fig
