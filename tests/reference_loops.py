@@ -6,8 +6,8 @@ numerical refinements. The pack's fast engine (:func:`lqe_helpers.filter.kalman_
 (``tests/test_reference.py``), and the checks' tests use them as the worked answers.
 
 These loops answer tasks of notebooks 01 and 05, so they live here, outside the package,
-and stay out of the student pack (``INSTRUCTOR_TESTS`` in
-``lqe_helpers/authoring/student_pack.py``). Imported by tests as ``reference_loops``
+and stay out of the student pack (which ships only the tests ``PACK_TESTS`` of
+``lqe_helpers/authoring/student_pack.py`` lists). Imported by tests as ``reference_loops``
 (pytest puts ``tests/`` on ``sys.path``).
 """
 

@@ -51,7 +51,7 @@ from pathlib import Path
 
 import nbformat
 import pytest
-from artefacts import StudentEdition
+from artefacts import StudentEdition, StudentPack
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers.authoring import student_edition as se
@@ -326,3 +326,47 @@ def test_a_number_typed_in_code_is_an_input_not_a_result():
     notebook.cells[2].outputs[0].text += "assumed 13.5 cm\n"
     leaks = find_leaks(notebook, student_of(notebook, "inputs"))
     assert [leak.split(" contains ")[1].split(",")[0] for leak in leaks] == ["1.259"]
+
+
+# ------------------------------------------------------------- the pack's own texts
+
+
+def texts_leaks(texts: dict[str, str], sources: list[Path]) -> list[str]:
+    """Where ``texts`` (name → Markdown) repeat a result or an answer of any notebook.
+
+    The pack's README and STUDENT-PACK.md come before every task, so any result a
+    solution cell prints (:func:`printed_results`, excepting the question's own numbers
+    and typed inputs) or any sentence of a worked answer leaks there.
+    """
+    found = []
+    for path in sources:
+        notebook = nbformat.read(path, as_version=4)
+        printed = printed_results(notebook)
+        answers = answer_sentences(notebook)
+        for name, text in texts.items():
+            for value in sorted(results(text) & set(printed)):
+                found.append(f"{name} contains {value}, printed by {path.stem}: "
+                             f"{printed[value]}")
+            flat = normalise(text)
+            found += [f"{name} repeats a sentence of {path.stem}'s answer {where}: "
+                      f"{sentence!r}" for sentence, where in answers.items()
+                      if sentence in flat]
+    return found
+
+
+def test_a_result_in_the_packs_readme_is_found(tmp_path):
+    notebook = leak_fixture()
+    source = tmp_path / "01_fixture.ipynb"
+    nbformat.write(notebook, source)
+    leaks = texts_leaks({"README.md": "Filtering brings the MSE to 1.259 cm².",
+                         "notes": "Yes: the filtered estimate is six times closer to the "
+                                  "truth than vision."}, [source])
+    assert [leak.split(",")[0] for leak in leaks] == [
+        "README.md contains 1.259", "notes repeats a sentence of 01_fixture's answer source"]
+
+
+def test_the_packs_own_texts_give_no_answer_away(student_pack: StudentPack):
+    texts = {name: (student_pack.folder / name).read_text("utf-8")
+             for name in ("README.md", "STUDENT-PACK.md")}
+    leaks = texts_leaks(texts, NOTEBOOKS)
+    assert not leaks, "\n".join(leaks)

@@ -14,6 +14,7 @@ which the course's own run executes in full.
 from __future__ import annotations
 
 import json
+import re
 import shlex
 import subprocess
 import sys
@@ -33,7 +34,7 @@ from lqe_helpers.authoring.errors import OutputFolderError
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 #: Unit tests run inside the pack besides the structure tests (the rest are collected).
-SAMPLE_UNIT_TESTS = ("test_reference", "test_scenario")
+SAMPLE_UNIT_TESTS = ("test_student_code", "test_validation")
 
 
 @pytest.fixture
@@ -106,17 +107,30 @@ def test_pack_makefile_refuses_a_makefile_it_cannot_keep_lab_from(text, message)
         sp.pack_makefile(text)
 
 
-@pytest.mark.parametrize(("relative", "text", "instructor"), [
-    ("browser/test_lab_server.py", "", True),
-    ("test_student_edition.py", "", True),
-    ("test_filter.py", "import numpy", False),
-    ("test_new.py", "from lqe_helpers.authoring import handouts", True),
-    ("test_new.py", 'NOTEBOOKS = ROOT / "notebooks"', True),
-    ("explorer_checks.py", "def helper(): pass", False),
-    ("data.json", None, False),
-])
-def test_instructor_tests_stay_out(relative, text, instructor):
-    assert sp.is_instructor_test(Path(relative), text) is instructor
+#: What no test shipped to students may import or read: the oracle loops, the checks'
+#: worked and wrong answers, the instructor's tools, the worked notebooks, the suite's
+#: shared builds.
+INSTRUCTOR_ONLY = re.compile(r"reference_loops|check_outcomes|lqe_helpers\.authoring"
+                             r"|from lqe_helpers import authoring|[\"']notebooks[\"']"
+                             r"|(?:from|import) (?:artefacts|once_per_run|make_env)\b"
+                             r"|[\"']artefacts[\"']")
+
+
+@pytest.mark.parametrize("name", sp.PACK_TESTS)
+def test_every_test_the_pack_ships_exists_and_needs_nothing_of_the_instructor(name):
+    text = (ROOT / "tests" / name).read_text("utf-8")
+    if name == "conftest.py":  # it loads the artefacts plugin only where that file exists
+        text = text.replace('pytest_plugins = ["artefacts"] if (Path(__file__).parent / '
+                            '"artefacts.py").is_file() else []', "")
+    assert not INSTRUCTOR_ONLY.search(text), INSTRUCTOR_ONLY.search(text)
+
+
+def test_a_new_test_stays_with_the_instructor_unless_it_is_listed():
+    """The pack lists what may ship: a test added to tests/ is left out by default."""
+    shipped = set(sp.PACK_TESTS)
+    assert {path.name for path in (ROOT / "tests").glob("test_checks_*.py")}.isdisjoint(shipped)
+    assert {"reference_loops.py", "test_reference.py", "test_smoothing.py",
+            "test_science_numbers.py", "check_outcomes.py"}.isdisjoint(shipped)
 
 
 # ------------------------------------------------------------------ the zip
@@ -137,14 +151,11 @@ def test_the_pack_holds_what_a_student_needs_and_nothing_of_the_instructor(pack)
     assert not [name for name in inside if name.startswith("lqe_helpers/authoring")]
     assert not [name for name in inside if "__pycache__" in name or name.endswith(".pyc")]
     assert not [name for name in inside if "marking" in name]
-    for left_out in sp.INSTRUCTOR_TESTS:
-        assert not [name for name in inside if name.startswith(f"tests/{left_out}")]
-    unit_tests = {path.name for path in (ROOT / "tests").glob("test_*.py")
-                  if not sp.is_instructor_test(Path(path.name), path.read_text("utf-8"))}
-    assert unit_tests and {f"tests/{name}" for name in unit_tests} <= inside
+    assert {name for name in inside if name.startswith("tests/")} == {
+        f"tests/{name}" for name in (*sp.PACK_TESTS, sp.STRUCTURE_TEST, sp.CONVENTIONS_NAME)}
+    assert not [name for name in inside if "my_functions" in name]
     assert (folder / "pyproject.toml").read_bytes() == (ROOT / "pyproject.toml").read_bytes()
-    assert (folder / "README.md").read_text().startswith(
-        (ROOT / "README.md").read_text().split("\n\n")[0] + "\n\n" + sp.README_NOTE)
+    assert (folder / "README.md").read_bytes() == (sp.PACK_FILES / sp.STUDENT_README).read_bytes()
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)

@@ -74,7 +74,7 @@ def test_ctrl_c_while_a_tool_is_importing_is_one_line(tmp_path, tool):
 
 # --- files named --------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("where", ["tests/test_latin1.py", "README.md", "Makefile"])
+@pytest.mark.parametrize("where", ["tests/test_validation.py", "Makefile"])
 def test_a_non_utf8_file_in_the_pack_is_named(tmp_path, where):
     course = make_course(tmp_path / "course")
     path = course / where

@@ -31,14 +31,14 @@ def course(tmp_path: Path) -> Path:
 
 
 @pytest.mark.parametrize("link", [
-    "tests/marking-guide.md", "lqe_helpers/guide.md", "tests/data", "notebooks/02_link.ipynb",
-    "README.md",
+    "tests/test_validation.py", "lqe_helpers/guide.md", "lqe_helpers/data",
+    "notebooks/02_link.ipynb",
 ])
 def test_a_symlink_in_what_the_pack_copies_stops_the_build(tmp_path, course, link):
     path = course / link
     if path.exists():
         path.unlink()
-    target = tmp_path / "instructor" / ("marking-guide.md" if link != "tests/data" else "")
+    target = tmp_path / "instructor" / ("" if link.endswith("data") else "marking-guide.md")
     if link.endswith(".ipynb"):
         target = write_notebook(tmp_path / "instructor" / "02_worked.ipynb")
     path.symlink_to(target)
@@ -59,8 +59,15 @@ def test_before_the_fix_the_guide_would_have_been_in_the_zip(tmp_path, course):
 
 
 def test_a_fifo_in_the_tests_stops_the_build_without_blocking(tmp_path, course):
-    fifo = course / "tests" / "pipe.py"
-    os.mkfifo(fifo)
+    shipped = course / "tests" / "test_validation.py"  # a test the pack copies
+    shipped.unlink()
+    os.mkfifo(shipped)
+    with pytest.raises(ValueError, match=r"test_validation\.py is not a regular file \(a fifo"):
+        student_pack.build_student_pack(course, tmp_path / "out")
+    (course / "lqe_helpers" / "pipe.py").unlink(missing_ok=True)
+    shipped.unlink()
+    shipped.write_text("def test_shipped():\n    assert True\n")
+    os.mkfifo(course / "lqe_helpers" / "pipe.py")
     with pytest.raises(ValueError, match=r"pipe\.py is neither a file nor a folder"):
         student_pack.build_student_pack(course, tmp_path / "out")
 

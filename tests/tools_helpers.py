@@ -17,6 +17,8 @@ from pathlib import Path
 import nbformat
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
+from lqe_helpers.authoring import student_pack
+
 ROOT = Path(__file__).resolve().parents[1]
 #: The code the command-line tests run: this folder's, or (to see a test fail before a fix)
 #: another checkout named by LQE_TOOLS_UNDER_TEST.
@@ -92,6 +94,8 @@ def make_course(root: Path) -> Path:
     (root / "lqe_helpers" / "science.py").write_text("VALUE = 1\n")
     (root / "tests").mkdir()
     (root / "tests" / "test_science.py").write_text("def test_value():\n    assert True\n")
+    for name in student_pack.PACK_TESTS:  # the tests the pack ships, here trivial ones
+        (root / "tests" / name).write_text("def test_shipped():\n    assert True\n")
     write_notebook(root / "notebooks" / "01_first.ipynb")
     return root
 

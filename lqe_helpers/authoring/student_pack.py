@@ -10,18 +10,21 @@
   instructor's tools (run notebooks, build handouts, the student edition, this pack,
   the marking guide); nothing a student runs (notebooks, explorers, checks, ``make lab``,
   ``make test``) imports them, and leaving them out keeps the pack to what students use;
-- ``README.md`` (with a first note saying this is the student pack), ``pyproject.toml``,
-  ``constraints.txt``;
+- ``README.md``: the students' own (:data:`STUDENT_README`: what to run, how to work a
+  notebook, where help is), not the course's, which speaks to instructors and
+  maintainers; ``pyproject.toml``, ``constraints.txt``;
 - ``Makefile``: the pack's own, generated from the course's Makefile by keeping its
   variables and its ``$(BIN)/python``, ``$(STAMP)``, ``lab`` and ``clean`` rules word for
   word (so ``make lab`` is identical) and replacing ``test``: it runs ``pytest tests``
   (the unit tests and the structure checks below), without ruff and without nbval, which
   would stop at the first unfinished task by design;
-- ``tests/``: the unit tests of the package, plus ``test_student_notebooks.py`` (the
-  structure of the student notebooks: valid, student tags only, a check after every core
-  task, imports that resolve) with its conventions in ``student_pack.json``. Tests for
-  the instructor's side (:data:`INSTRUCTOR_TESTS`, and any other test that imports
-  ``lqe_helpers.authoring`` or reads the worked notebooks) are left out;
+- ``tests/``: only the tests listed in :data:`PACK_TESTS` (the pack's infrastructure:
+  input checks, the student-code machinery, plotting; none holds a worked answer or a
+  task's result), plus ``test_student_notebooks.py`` (the structure of the student
+  notebooks: valid, student tags only, a check after every core task, imports that
+  resolve) with its conventions in ``student_pack.json``. Every other test stays with the
+  instructor: a list of what may ship, not of what may not, so a new test (a check's
+  wrong answers, an oracle loop, a task's numbers) never reaches students by default;
 - ``STUDENT-PACK.md``: what the pack is, how to start, and what was left out.
 
 The marking guide is never in the pack. The zip is the same, byte for byte, for the same
@@ -56,25 +59,17 @@ PACK_NAME = "lqe-student-pack"
 ZIP_NAME = f"{PACK_NAME}.zip"
 #: What the pack is, at its top level (also marks an unpacked folder as a student pack).
 MARKER_NAME = "STUDENT-PACK.md"
-#: Files copied from the top of the course folder as they are (the README gets a note).
-TOP_FILES = ("README.md", "pyproject.toml", "constraints.txt")
+#: Files copied from the top of the course folder as they are.
+TOP_FILES = ("pyproject.toml", "constraints.txt")
 #: Folders of the course folder the pack copies from; its output folder may not overlap them.
 SOURCES = ("notebooks", "lqe_helpers", "tests")
 #: Sub-packages of lqe_helpers that stay with the instructor.
 INSTRUCTOR_PACKAGES = ("authoring",)
-#: Tests (files or folders under tests/) of the instructor's side, left out of the pack.
-INSTRUCTOR_TESTS = ("browser", "test_notebook_files.py", "test_student_edition.py",
-                    "test_student_leaks.py", "test_student_pack.py", "test_marking_guide.py",
-                    "test_handouts.py", "test_notebook_runner.py",
-                    # worked answers of tasks: the eq. (5)/(7) oracle and the checks' tests
-                    "reference_loops.py", "test_reference.py", "test_checks_background.py",
-                    "test_checks_vision.py", "test_checks_initial_covariance.py",
-                    "test_checks_fusion.py", "test_checks_numbers.py", "test_checks_delay.py",
-                    "test_checks_bias.py", "test_checks_noisier_proprioception.py",
-                    "test_checks_delay_going_further.py")
-#: A test that mentions these needs what the pack leaves out (authoring, worked notebooks).
-INSTRUCTOR_ONLY = re.compile(r"lqe_helpers\.authoring|from lqe_helpers import authoring"
-                             r"|[\"']notebooks[\"']")
+#: The only files of tests/ the pack ships (every other one stays with the instructor):
+#: tests of the pack's infrastructure that hold no worked answer and no task's result.
+PACK_TESTS = ("conftest.py", "test_validation.py", "test_public_errors.py",
+              "test_memory_limits.py", "test_distributions.py", "test_student_code.py",
+              "test_plotting.py", "test_png.py", "test_explorer_cache.py")
 #: Rules of the course Makefile the pack keeps word for word.
 KEPT_RULES = ("$(BIN)/python", "$(STAMP)", "lab", "clean")
 #: A rule's first line in a Makefile (not a variable assignment with ``:=``).
@@ -88,6 +83,8 @@ test: $(STAMP)
 \t$(BIN)/python -m pytest tests $(PYTEST_ARGS)"""
 #: Where the files shipped only in the pack live in the course folder.
 PACK_FILES = Path(__file__).resolve().parent / "student_pack_files"
+#: The students' README, in :data:`PACK_FILES`; shipped as the pack's ``README.md``.
+STUDENT_README = "README.md"
 #: The structure test shipped in the pack's tests/.
 STRUCTURE_TEST = "test_student_notebooks.py"
 #: Its conventions, written at build time from the student edition's definitions.
@@ -97,10 +94,6 @@ CHECKED_PREFIXES = ("01_", "02_", "03_", "04_", "05_")
 #: Date and time of every file in the zip (the earliest a zip can hold): same sources,
 #: same bytes.
 ZIP_TIME = (1980, 1, 1, 0, 0, 0)
-README_NOTE = (
-    "> **This is the student pack.** The notebooks in `notebooks/` are the student edition: "
-    "the tasks are yours to write and the answers yours to give. Start with `make lab`; "
-    f"see `{MARKER_NAME}` for what `make test` checks here.\n\n")
 
 
 def pack_makefile(course_makefile: str) -> str:
@@ -144,13 +137,6 @@ def pack_makefile(course_makefile: str) -> str:
         raise ValueError(f"the Makefile has no rule {', '.join(missing)}, which the student "
                          f"pack needs")
     return "\n\n".join(kept) + "\n"
-
-
-def is_instructor_test(relative: Path, text: str | None) -> bool:
-    """Whether a file under ``tests/`` stays with the instructor (see the module docstring)."""
-    if relative.parts[0] in INSTRUCTOR_TESTS:
-        return True
-    return text is not None and bool(INSTRUCTOR_ONLY.search(text))
 
 
 def source_folders(root: Path) -> list[Path]:
@@ -232,7 +218,8 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
         names the file).
     """
     root = Path(root)
-    for needed in ("Makefile", *TOP_FILES, "lqe_helpers/__init__.py", "tests"):
+    for needed in ("Makefile", *TOP_FILES, "lqe_helpers/__init__.py", "tests",
+                   *(f"tests/{name}" for name in PACK_TESTS)):
         if not (root / needed).exists():
             raise ValueError(f"root must be the course folder; {root / needed} is missing")
     files: dict[str, bytes] = {}
@@ -247,14 +234,14 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
         relative = path.relative_to(root / "lqe_helpers")
         if relative.parts[0] not in INSTRUCTOR_PACKAGES:
             files[f"lqe_helpers/{relative.as_posix()}"] = path.read_bytes()
-    left_out = []
-    for path in _files_under(root / "tests"):
-        relative = path.relative_to(root / "tests")
-        text = _read_text(path) if path.suffix == ".py" else None
-        if is_instructor_test(relative, text):
-            left_out.append(relative.parts[0])
-        else:
-            files[f"tests/{relative.as_posix()}"] = path.read_bytes()
+    for name in PACK_TESTS:
+        path = root / "tests" / name
+        _refuse_link(path)
+        if not path.is_file():
+            raise ValueError(f"{shown(path)} is not a regular file (a fifo, a device or a "
+                             f"folder); the student pack copies only files: put the test "
+                             f"itself there")
+        files[f"tests/{name}"] = _read_text(path).encode()  # non-UTF-8 text stops it, named
     files[f"tests/{STRUCTURE_TEST}"] = (PACK_FILES / STRUCTURE_TEST).read_bytes()
     conventions = {
         "tags": sorted(se.STUDENT_TAGS), "task_tag": se.TASK_TAG,
@@ -264,19 +251,16 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     }
     files[f"tests/{CONVENTIONS_NAME}"] = (json.dumps(conventions, indent=1) + "\n").encode()
     files["Makefile"] = pack_makefile(_read_text(root / "Makefile")).encode()
-    readme = _read_text(root / "README.md")
-    title, _, rest = readme.partition("\n\n")
-    files["README.md"] = f"{title}\n\n{README_NOTE}{rest}".encode()
-    for name in TOP_FILES[1:]:
+    files["README.md"] = _read_text(PACK_FILES / STUDENT_README).encode()
+    for name in TOP_FILES:
         files[name] = _read_bytes(root / name)
-    files[MARKER_NAME] = marker_text(sorted(set(left_out))).encode()
+    files[MARKER_NAME] = marker_text().encode()
     return dict(sorted(files.items()))
 
 
-def marker_text(left_out_tests: Sequence[str]) -> str:
+def marker_text() -> str:
     """The text of :data:`MARKER_NAME`."""
-    tests = ", ".join(f"`tests/{name}`" for name in left_out_tests) or "none"
-    return f"""# The LQE course pack: student pack
+    return """# The LQE course pack: student pack
 
 This folder is the course pack for students. The notebooks in `notebooks/` are the
 student edition: every cell that starts with `# Task:` is yours to write, and every
@@ -284,7 +268,7 @@ student edition: every cell that starts with `# Task:` is yours to write, and ev
 
 ```bash
 make lab     # first run: creates .venv, installs everything, opens JupyterLab on notebooks/
-make test    # the unit tests of lqe_helpers and the structure of the notebooks
+make test    # checks the installation and the structure of the notebooks
 ```
 
 `make test` here does not run the notebooks (your unfinished tasks would stop it by design);
@@ -293,7 +277,8 @@ after every core task, and that its imports resolve. The checks inside the noteb
 whether your code is right: run a task, then the check cell below it.
 
 Left out of this pack, for the instructor: the worked notebooks, the marking guide, the
-authoring tools (`lqe_helpers/authoring/`) and their tests ({tests}).
+authoring tools (`lqe_helpers/authoring/`) and every test that is not about this
+installation. `README.md` says how to work through the notebooks.
 """
 
 
