@@ -93,7 +93,8 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
     right = {dt: model.transition_matrix(dt) for dt in _TRANSITION_DTS}
     answers = {}
     for dt in _TRANSITION_DTS:
-        output = call_student(make_A, dt, name=name, where=f"dt = {dt:g} s", arg_names=("dt",))
+        output = call_student(make_A, dt, name=name, where=f"dt = {dt:g} s", arg_names=("dt",),
+                              forbid=(model.transition_matrix,))
         array = student_result(output, name=name, where=f"dt = {dt:g} s",
                                what="the transition matrix A, an array of shape (3, 3)")
         if array.shape != (3, 3):
@@ -197,7 +198,7 @@ def _judge_covariance_step(predict_covariance: Callable[..., np.ndarray], check:
         where = f"P and F of shape {P.shape}, G of shape {G.shape}, sigma = {sigma:.3g}"
         output = call_student(
             predict_covariance, P, F, G, sigma, name=name, where=where,
-            arg_names=("P", "F", "G", "sigma"),
+            arg_names=("P", "F", "G", "sigma"), forbid=(propagate_covariance,),
             shape_hint="P and F are (k, k), G is (k, r): write each term's shape.")
         array = student_result(output, name=name, where=where,
                                what=f"the new covariance P, an array of shape {P.shape}")
