@@ -119,6 +119,17 @@ def test_judge_interval_passes_the_right_one_and_names_the_usual_mistakes(runs) 
                                            "first MSE")
 
 
+def test_runs_shuffled_out_of_their_pairs_are_named(runs) -> None:
+    """The mean survives a shuffle of one condition's runs; the paired interval does not."""
+    first, second = runs
+    right = metrics.mean_ci95(first - second)
+    shuffled = metrics.mean_ci95(first - np.random.default_rng(0).permutation(second))
+    message = assert_fails("Are the runs paired, run r with run r", judge_interval, "d",
+                           shuffled, right, 1e-9,
+                           mistakes=interval_mistakes(first, second, "a", "b"))
+    assert message.startswith("d: the mean (")
+
+
 def test_judge_interval_names_what_is_not_an_interval(runs) -> None:
     first, second = runs
     right = metrics.mean_ci95(first - second)

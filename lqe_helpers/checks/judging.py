@@ -187,9 +187,13 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
             raise CheckFailed(f"{name} is not right: {cause}")
     unit_text = f" {unit}" if unit else ""
     if near(got[:1], right[:1]):
+        wider = (got[2] - got[1]) > 1.5 * (right[2] - right[1])
         raise CheckFailed(
             f"{name}: the mean ({got[0]:.6g}{unit_text}) is right, but the interval's ends "
-            f"are not those of metrics.mean_ci95 of the per-run values")
+            f"are not those of metrics.mean_ci95 of the per-run values"
+            + (": it is much wider than the paired interval. Are the runs paired, run r "
+               "with run r (the same noise draw), in their order, before taking the interval "
+               "of the differences?" if wider else ""))
     raise CheckFailed(
         f"{name} (mean {got[0]:.6g}{unit_text}) does not match {what} (to "
         f"{tolerance_text(rtol)} relative), and not by one of the usual mistakes")
