@@ -153,8 +153,12 @@ def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:
             raise IndexError
         n_steps = signal.shape[axis]
     except IndexError:
+        one_trace = (" (a single trace of shape (n,) has only axis -1 = 0: pass axis=-1, or "
+                     "delay the (n, m) readings and take a column afterwards)"
+                     if signal.ndim == 1 and axis == -2 else "")
         raise ValueError(
             f"axis must name an axis of signal with shape {signal.shape}, got {axis!r}"
+            f"{one_trace}"
         ) from None
     steps = validation.count("steps", steps, minimum=0, maximum=n_steps - 1)
     validation.check_memory(f"signal of shape {signal.shape}", 2 * signal.size,

@@ -69,6 +69,8 @@ def test_delay_signal_shifts_and_pads_with_nan() -> None:
         ),
         (lambda: simulation.delay_signal(np.zeros((5, 1)), 1.5), "steps must be a whole number"),
         (lambda: simulation.delay_signal(np.zeros(5), 1, axis=3), "axis must name an axis"),
+        (lambda: simulation.delay_signal(np.zeros(5), 1),
+         r"got -2 \(a single trace of shape \(n,\) has only axis -1 = 0: pass axis=-1"),
         (lambda: simulation.delay_signal(np.zeros(5), 1, axis="time"),
          r"axis must name an axis of signal with shape \(5,\), got 'time'"),
         (lambda: simulation.delay_signal(np.zeros(5), 1, axis=True),

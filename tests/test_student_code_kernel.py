@@ -119,7 +119,8 @@ def test_the_time_limit_stops_an_endless_loop_in_the_kernel(executed) -> None:
 def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     notebook, folder = executed
     assert "".join(output.text for output in notebook.cells[6].outputs) == (
-        "doubled is saved in my_functions/doubled.py; later notebooks load it from there\n42\n")
+        "doubled is saved in my_functions/doubled.py; the explorers and later notebooks "
+        "load it from there\n42\n")
     name, shown = error_of(notebook.cells[7])
     assert name == "StudentCodeError"
     assert shown.rstrip().endswith(
@@ -141,3 +142,25 @@ def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     assert name == "NotSavedYet"
     assert "my_filter is not saved yet" in shown
     assert_only_the_students_code(shown)
+
+
+def test_an_input_error_of_the_pack_shows_only_the_students_code(tmp_path) -> None:
+    """After student_code.brief_errors(), a ValueError the pack raises about an input
+    shows the student's cell and the message; an error of the student's own code, and one
+    of numpy, keep IPython's usual traceback."""
+    notebook = run(["import numpy as np\nfrom lqe_helpers import metrics, student_code\n"
+                    "student_code.brief_errors()",
+                    "estimate = np.array([np.nan, 1.0])\n"
+                    "mse = metrics.mse(estimate, np.zeros(2))",
+                    "def mine():\n    raise ValueError('my own')\nmine()",
+                    "np.zeros(2) @ np.zeros(3)"], tmp_path)
+    assert notebook.cells[0].outputs == []
+    name, shown = error_of(notebook.cells[1])
+    assert name == "ValueError"
+    assert "mse = metrics.mse(estimate, np.zeros(2))" in shown
+    assert "estimate must be finite" in shown
+    assert_only_the_students_code(shown)
+    name, shown = error_of(notebook.cells[2])
+    assert name == "ValueError" and "raise ValueError('my own')" in shown
+    name, shown = error_of(notebook.cells[3])
+    assert name == "ValueError" and "matmul" in shown

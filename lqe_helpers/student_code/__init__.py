@@ -20,6 +20,7 @@ from .errors import (
     OwnCodeTraceback,
     StudentCodeError,
     TimedOut,
+    brief_errors,
     is_own_code,
     own_frames,
 )
@@ -39,6 +40,7 @@ __all__ = [
     "StudentCodeError",
     "TimedOut",
     "array_problem",
+    "brief_errors",
     "call",
     "function_name",
     "is_own_code",

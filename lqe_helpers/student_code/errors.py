@@ -66,6 +66,43 @@ class NotSavedYet(StudentCodeError):
     """A function another notebook saves (``my_functions/<name>.py``) is not saved yet."""
 
 
+def brief_errors() -> None:
+    """In a notebook, show an input error the pack raises under the student's own code only.
+
+    A ``ValueError`` or ``TypeError`` raised inside ``lqe_helpers`` (it names the input
+    and what is allowed, e.g. a NaN passed to ``metrics.mse``) is then shown as the
+    student's own frames and that one message, like a failed check, instead of pages of
+    the pack's source; any other error keeps IPython's usual traceback. The notebooks
+    call this in their first code cell; nothing happens outside IPython.
+    """
+    shell = _ipython_shell()
+    if shell is None:
+        return
+
+    def handler(self, etype, value, tb, tb_offset=None):  # IPython's CustomTB signature
+        if _raised_by_the_pack(tb):
+            stb = self.InteractiveTB.structured_traceback(etype, value, own_frames(tb),
+                                                          tb_offset=0)
+        else:
+            stb = self.InteractiveTB.structured_traceback(etype, value, tb,
+                                                          tb_offset=tb_offset)
+        self._showtraceback(etype, value, stb)
+        return stb
+
+    shell.set_custom_exc((ValueError, TypeError), handler)
+
+
+def _raised_by_the_pack(tb: types.TracebackType | None) -> bool:
+    """Whether the last frame of ``tb`` (where the error was raised) is the pack's code."""
+    last = None
+    while tb is not None:
+        last, tb = tb, tb.tb_next
+    if last is None:
+        return False
+    path = os.path.realpath(last.tb_frame.f_code.co_filename)
+    return path.startswith(os.path.join(os.path.realpath(_PACKAGE_DIR), ""))
+
+
 def _ipython_shell():
     module = sys.modules.get("IPython")
     return module.get_ipython() if module is not None else None
