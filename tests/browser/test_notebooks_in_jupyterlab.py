@@ -4,7 +4,9 @@ Each course notebook is opened in JupyterLab in Chromium (a copy, so autosave ne
 touches the committed file), its outputs are cleared and Run > Run All Cells is
 clicked. The run must end with every code cell executed and no error output. Then
 every slider of every explorer is moved by keyboard and by typing into its readout,
-and each move must show a new picture and new numbers in the line above it; the
+and each move must show a new picture and new numbers in the line above it; where the
+notebook gives the explorer the student's filter (``filter=my_filter``, notebooks
+01–05), the line must say after every move that the student's function ran. The
 browser must log no error. Screenshots go to ``build/screenshots/``.
 """
 
@@ -33,11 +35,15 @@ from lab_driver import (
 pytestmark = [pytest.mark.browser, pytest.mark.timeout(300)]
 
 
-def explorer_cell_count(path: Path) -> int:
-    """Code cells tagged ``explorer`` in the notebook file."""
+def explorer_cells(path: Path) -> list[str]:
+    """The sources of the code cells tagged ``explorer`` in the notebook file."""
     notebook = nbformat.read(path, as_version=4)
-    return sum(cell.cell_type == "code" and "explorer" in cell.metadata.get("tags", [])
-               for cell in notebook.cells)
+    return [cell.source for cell in notebook.cells
+            if cell.cell_type == "code" and "explorer" in cell.metadata.get("tags", [])]
+
+
+#: What an explorer running the student's own filter says in its numbers line.
+STUDENTS_FILTER = "your my_filter"
 
 
 @contextmanager
@@ -65,7 +71,8 @@ def test_every_slider_redraws_in_jupyterlab(lab_page, lab_server: LabServer,
         assert not skipped, f"{notebook.name}: cells not executed by Run All: {skipped}"
 
         views = explorers(panel)
-        expected = explorer_cell_count(notebook)
+        sources = explorer_cells(notebook)
+        expected = len(sources)
         assert len(views) == expected, (
             f"{notebook.name}: {expected} cell(s) tagged 'explorer' but {len(views)} live "
             "explorer(s) with sliders on the page")
@@ -77,9 +84,16 @@ def test_every_slider_redraws_in_jupyterlab(lab_page, lab_server: LabServer,
             assert view.numbers.count() == 1, (
                 f"{notebook.name}, explorer {number}: expected one numbers line, "
                 f"found {view.numbers.count()}")
+            # An explorer given the student's filter runs it on every move, and says so.
+            students = "filter=" in sources[number - 1]
             for description, slider in iter_sliders(view):
                 exercise_slider(view, slider,
                                 f"{notebook.name}, explorer {number}, slider {description!r}")
+                if students:
+                    line = view.numbers.inner_text()
+                    assert STUDENTS_FILTER in line.lower(), (
+                        f"{notebook.name}, explorer {number}: after moving {description!r} "
+                        f"the numbers line does not say it ran {STUDENTS_FILTER}: {line!r}")
             view.output.screenshot(path=screenshot_path(f"{notebook.stem}-explorer-{number}"))
 
         problems = error_outputs(page, panel)
