@@ -309,8 +309,8 @@ def shadows_sum(x):
 def test_save_writes_the_source_and_returns_the_function_loaded_back(tmp_path, capsys) -> None:
     folder = tmp_path / "my_functions"
     loaded = student_code.save(doubled, folder)
-    assert capsys.readouterr().out == (f"doubled is saved in {folder / 'doubled.py'}; the "
-                                       f"explorers and later notebooks load it from there\n")
+    assert capsys.readouterr().out == (f"doubled is saved in {folder / 'doubled.py'}, where "
+                                       f"student_code.load('doubled') finds it\n")
     text = (folder / "doubled.py").read_text("utf-8")
     assert text.splitlines()[0] == student_code.SAVE_HEADER
     assert "import numpy as np\n\n\ndef doubled(x):\n    \"\"\"Twice x, as an array.\"\"\"" in text

@@ -119,8 +119,8 @@ def test_the_time_limit_stops_an_endless_loop_in_the_kernel(executed) -> None:
 def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     notebook, folder = executed
     assert "".join(output.text for output in notebook.cells[6].outputs) == (
-        "doubled is saved in my_functions/doubled.py; the explorers and later notebooks "
-        "load it from there\n42\n")
+        "doubled is saved in my_functions/doubled.py, where student_code.load('doubled') "
+        "finds it\n42\n")
     name, shown = error_of(notebook.cells[7])
     assert name == "StudentCodeError"
     assert shown.rstrip().endswith(

@@ -141,7 +141,7 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
         old = None
     if old != text:
         _write(path, text)
-    print(f"{name} is saved in {shown}; the explorers and later notebooks load it from there")
+    print(f"{name} is saved in {shown}, where student_code.load({name!r}) finds it")
     return load(name, path.parent)
 
 
