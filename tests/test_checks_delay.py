@@ -165,52 +165,56 @@ def test_check_compensation_refuses_inf_and_huge_values() -> None:
 
 
 # ------------------------------------------------------------------------------------------
-# check_delay_mse (Task 2)
+# check_delay_signals (Task 2)
 # ------------------------------------------------------------------------------------------
 
 TRUTH = DEFAULT.truth[:, 0]
-BURN = DEFAULT.burn_in_steps
 STEPS = DEFAULT.delay_steps(DEFAULT.delay)
 #: Task 2's given inputs: the trial's readings (n, 1) and the model of the vision-only filter.
 READINGS = simulation.measure(TRUTH, DEFAULT.unit_noise(sensors=("vision",)), [DEFAULT.sigma_v])
 VISION = experiments.filter_model(DEFAULT)
 
 
+def unguarded_filter(y, A, C, Q, R, z0, P0):
+    """A student's eq. (5) loop, which (unlike the oracle) does not refuse NaN readings."""
+    z, P, rows = z0, P0, []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        rows.append(z)
+    return np.array(rows)
+
+
 def task2(slip: str = "") -> tuple:
     """Task 2 as a student writes it (the notebook's worked code), with one ``slip``.
 
-    Returns (late_readings, delayed, compensated, mse_delayed_run, mse_compensated_run).
+    Returns (late_readings, delayed, compensated).
     """
     y, m = READINGS, VISION
     steps = STEPS + (slip == "one sample late")
-    estimates = reference.lqe_filter(y, m.A, m.C, m.Q, m.R, m.z0, m.P0)   # my_filter
-    late_readings = simulation.delay_signal(y, steps)[:, 0]
+    late_y = simulation.delay_signal(y, steps)
+    if slip == "filter the late readings":
+        estimates = unguarded_filter(late_y, m.A, m.C, m.Q, m.R, m.z0, m.P0)
+    else:
+        estimates = reference.lqe_filter(y, m.A, m.C, m.Q, m.R, m.z0, m.P0)   # my_filter
+    late_readings = late_y[:, 0]
     if slip == "np.roll":
         late_readings = np.roll(y, steps, axis=0)[:, 0]
+    elif slip == "truth seen late":
+        late_readings = simulation.delay_signal(TRUTH, steps, axis=-1)
+    column = 1 if slip == "velocity column" else 0
     delayed_states = simulation.delay_signal(estimates, steps)
     delayed = {"whole states": delayed_states, "not delayed": estimates[:, 0],
-               "late readings": late_readings}.get(slip, delayed_states[:, 0])
+               "late readings": late_readings}.get(slip, delayed_states[:, column])
     source = delayed_states if slip == "compensate the delayed" else estimates
-    compensated = student_compensate(source, DEFAULT.A, steps)[:, 0]
-    skip = {"whole trial": 0, "skip only delta": steps}.get(slip, max(BURN, steps))
-    if slip == "nanmean":
-        mse_delayed_run = np.nanmean((delayed - TRUTH) ** 2)
-        mse_compensated_run = np.nanmean((compensated - TRUTH) ** 2)
-    else:   # the whole states' slip keeps the position column here, not in the array
-        positions = delayed_states[:, 0] if slip == "whole states" else delayed
-        mse_delayed_run = np.mean((positions[skip:] - TRUTH[skip:]) ** 2)
-        mse_compensated_run = np.mean((compensated[skip:] - TRUTH[skip:]) ** 2)
-    if slip == "rmse":
-        mse_compensated_run = np.sqrt(mse_compensated_run)
-    if slip == "swapped":
-        mse_delayed_run, mse_compensated_run = mse_compensated_run, mse_delayed_run
-    return late_readings, delayed, compensated, mse_delayed_run, mse_compensated_run
+    compensated = student_compensate(source, DEFAULT.A, steps)[:, column]
+    return late_readings, delayed, compensated
 
 
-def test_check_delay_mse_passes_the_worked_answer(capsys) -> None:
-    line = assert_passes(capsys, checks.check_delay_mse, *task2())
-    assert "(δ = 10 samples) match the pack's engine" in line
-    assert "their MSEs (after the first 100 samples) to 1e-6 relative" in line
+def test_check_delay_signals_passes_the_worked_answer(capsys) -> None:
+    line = assert_passes(capsys, checks.check_delay_signals, *task2())
+    assert "(δ = 10 samples) match the pack's engine on the scenario's draw to 1e-9" in line
 
 
 def test_task2_inputs_are_those_of_the_engine() -> None:
@@ -225,12 +229,6 @@ def test_task2_inputs_are_those_of_the_engine() -> None:
 @pytest.mark.parametrize(("slip", "phrase"), [
     ("compensate the delayed", "compensated is not right: compensate was given the delayed "
                                "estimates, so it predicts from 2δ samples back"),
-    ("whole trial", "mse_delayed_run is NaN (not a number): the first δ samples"),
-    ("skip only delta", "it leaves out only the first δ = 10 samples; leave out the burn-in too"),
-    ("nanmean", "mse_delayed_run = 5.20409 cm² is not right"),
-    ("nanmean", "it leaves out only the first δ = 10 samples; leave out the burn-in too"),
-    ("swapped", "mse_delayed_run = 1.9"),
-    ("swapped", "it is the MSE of the compensated estimate, not of the delayed one"),
     ("one sample late", "late_readings is not right: the delay is one sample too long (δ + 1)"),
     ("late readings", "delayed is not right: it holds the late readings, not the delayed "
                       "estimate"),
@@ -239,55 +237,62 @@ def test_task2_inputs_are_those_of_the_engine() -> None:
                      "the positions, column 0"),
     ("not delayed", "delayed is not right: it is not delayed: these are the estimates as the "
                     "filter made them"),
-    ("rmse", "mse_compensated_run = 1.38"),
-    ("rmse", "it is the root mean squared error (RMSE, in cm)"),
+    ("truth seen late", "late_readings is not right: it holds the true position seen late"),
+    ("velocity column", "delayed is not right: it holds velocities (column 1 of the states"),
+    ("filter the late readings", "delayed is NaN at every sample, also after j = δ = 10: was "
+                                 "your my_filter run on the late readings?"),
 ])
-def test_check_delay_mse_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
-    assert_fails(phrase, checks.check_delay_mse, *task2(slip))
+def test_check_delay_signals_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_delay_signals, *task2(slip))
 
 
-def test_check_delay_mse_catches_the_compensation_that_reverses_the_answer() -> None:
+def test_check_delay_signals_names_the_velocity_column_of_the_compensation() -> None:
+    late, delayed, _ = task2()
+    *_, velocities = task2("velocity column")
+    assert_fails("compensated is not right: it holds velocities (column 1 of the states",
+                 checks.check_delay_signals, late, delayed, velocities)
+
+
+def test_check_delay_signals_catches_the_compensation_that_reverses_the_answer() -> None:
     """Issue 15: compensating the wrong estimates makes compensation look useless."""
-    *_, delayed, compensated = task2("compensate the delayed")
-    assert compensated > 0.95 * delayed > 2 * task2()[4]   # the benefit of (e) is gone
-    assert_fails("given the delayed estimates", checks.check_delay_mse,
+    skip = max(DEFAULT.burn_in_steps, STEPS)
+
+    def mse(x):
+        return np.mean((x[skip:] - TRUTH[skip:]) ** 2)
+
+    _, delayed, wrong = task2("compensate the delayed")
+    assert mse(wrong) > 0.95 * mse(delayed) > 2 * mse(task2()[2])   # the benefit of (e) is gone
+    assert_fails("given the delayed estimates", checks.check_delay_signals,
                  *task2("compensate the delayed"))
 
 
-def test_check_delay_mse_names_nan_in_the_wrong_places() -> None:
-    late, delayed, compensated, *mses = task2()
+def test_check_delay_signals_names_nan_in_the_wrong_places() -> None:
+    late, delayed, compensated = task2()
     shifted = compensated.copy()
     shifted[STEPS] = np.nan
     assert_fails("compensated must be NaN in exactly its first δ = 10 samples (nothing has "
                  "arrived before j = δ) and a number after; yours has NaN in 11 samples",
-                 checks.check_delay_mse, late, delayed, shifted, *mses)
+                 checks.check_delay_signals, late, delayed, shifted)
 
 
-def test_check_delay_mse_refuses_another_draw() -> None:
-    """Numbers from another noise draw agree with each other but not with the task's."""
+def test_check_delay_signals_refuses_another_draw() -> None:
+    """Signals from another noise draw agree with each other but not with the task's."""
     other = scenario.Scenario(seed=DEFAULT.seed + 1)
     tracking = experiments.track(other)
     late = simulation.delay_signal(tracking.measurements, STEPS)[:, 0]
-    _, delayed, compensated, *mses = task2()
+    _, delayed, compensated = task2()
     assert_fails("late_readings does not match the signal recomputed from the task's inputs",
-                 checks.check_delay_mse, late, delayed, compensated, *mses)
+                 checks.check_delay_signals, late, delayed, compensated)
 
 
-def test_check_delay_mse_wants_numbers() -> None:
-    late, delayed, compensated, mse_delayed, mse_compensated = task2()
-    signals = (late, delayed, compensated)
-    assert_fails("mse_delayed_run must be one number (cm²), got None", checks.check_delay_mse,
-                 *signals, None, mse_compensated)
-    assert_fails("mse_compensated_run must be one number (cm²), got text ('1.92')",
-                 checks.check_delay_mse, *signals, mse_delayed, "1.92")
-    assert_fails("mse_compensated_run must be one number (cm²), got values too large to square",
-                 checks.check_delay_mse, *signals, mse_delayed, 1e300)
+def test_check_delay_signals_wants_arrays_of_positions() -> None:
+    late, delayed, compensated = task2()
     assert_fails("late_readings must be positions (cm), an array of shape (1000,), got None",
-                 checks.check_delay_mse, None, delayed, compensated, mse_delayed,
-                 mse_compensated)
+                 checks.check_delay_signals, None, delayed, compensated)
     assert_fails("delayed must be positions (cm) of shape (1000,), one per sample, got shape "
-                 "(990,)", checks.check_delay_mse, late, delayed[STEPS:], compensated,
-                 mse_delayed, mse_compensated)
+                 "(990,)", checks.check_delay_signals, late, delayed[STEPS:], compensated)
+    assert_fails("compensated has shape (1000, 1), one column per row",
+                 checks.check_delay_signals, late, delayed, compensated[:, None])
 
 
 # ------------------------------------------------------------------------------------------
@@ -329,6 +334,16 @@ def task3(slip: str = "") -> tuple:
                     / (mse_delayed.mean() - mse_now.mean()))
     elif slip == "upside down":
         won_back = metrics.mean_ci95((mse_delayed - mse_now) / (mse_delayed - mse_predicted))
+    elif slip == "numerator without parentheses":
+        won_back = metrics.mean_ci95(mse_delayed - mse_predicted / (mse_delayed - mse_now))
+    elif slip == "denominator without parentheses":
+        won_back = metrics.mean_ci95((mse_delayed - mse_predicted) / mse_delayed - mse_now)
+    elif slip == "divided by the undelayed MSE":
+        won_back = metrics.mean_ci95((mse_delayed - mse_predicted) / mse_now)
+    elif slip == "compensated over delayed":
+        won_back = metrics.mean_ci95(mse_predicted / mse_delayed)
+    elif slip == "names swapped":
+        gain, won_back = won_back, gain
     return gain, won_back
 
 
@@ -348,6 +363,13 @@ def test_check_delay_difference_passes_the_worked_answer(capsys) -> None:
     ("per cent", "won_back is not right: it is in per cent"),
     ("ratio of means", "won_back is a number; it must be the metrics.Interval"),
     ("upside down", "won_back is not right: the ratio is upside down"),
+    ("numerator without parentheses", "won_back is not right: the numerator's parentheses "
+                                      "are missing"),
+    ("denominator without parentheses", "won_back is not right: the denominator's "
+                                        "parentheses are missing"),
+    ("divided by the undelayed MSE", "won_back is not right: it divides by the undelayed MSE"),
+    ("compensated over delayed", "won_back is not right: it is compensated / delayed"),
+    ("names swapped", "gain is not right: it is the share of the delay's cost won back"),
 ])
 def test_check_delay_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_delay_difference, *task3(slip))

@@ -64,6 +64,11 @@ def _independent(delay: float, noise: np.ndarray, sigma_v: float = DEFAULT.sigma
     }
 
 
+def three_figures(value: float) -> str:
+    """``value`` (< 1000) to three significant figures, as the numbers line prints it."""
+    return f"{value:#.3g}".rstrip(".")
+
+
 def _texts(figure: Figure) -> list[str]:
     """Every non-empty text the figure draws (titles, labels, legend, tick labels)."""
     return sorted(t.get_text() for t in figure.findobj(Text) if t.get_text())
@@ -84,9 +89,9 @@ def _check_figure(figure: Figure, numbers: str, delay: float, noise: np.ndarray,
         assert np.all(np.isnan(lines[gid][:steps])), gid
         assert np.all(np.isfinite(lines[gid][steps:])), gid
     assert f"d = {delay:.2f} s" in numbers
-    assert f"δ = {steps} steps" in numbers
+    assert f"δ = {steps} {'step' if steps == 1 else 'steps'})" in numbers
     for name, value in expected["mse"].items():
-        assert f"{name} {value:.2f} cm²" in numbers, (name, numbers)
+        assert f"{name} {three_figures(value)} cm²" in numbers, (name, numbers)
     # The numbers are beside the figure, not in it.
     assert figure.get_suptitle() == ""
     assert not [text for text in _texts(figure)
@@ -193,6 +198,25 @@ def test_draw_function_on_a_fresh_figure_with_given_noise():
     # Default noise is the scenario's fixed draw.
     numbers = draw_delay(figure, delay=0.17)
     _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.01, 0.02, 0.5])
+def test_numbers_line_tells_the_three_mses_apart_at_every_delay(delay):
+    """Explore asks to compare them at d = 0 and at the shortest and longest delays: each MSE
+    keeps three significant figures (no "0.00"), and at 0.01 s, where the delayed and the
+    undelayed MSE differ by under 0.03 cm², the line still shows them different."""
+    explorer = explore_delay()
+    explorer.sliders["delay"].value = delay
+    mses = dict(re.findall(r"(delayed|compensated|no delay) ([\d.]+) cm²", explorer.numbers))
+    assert set(mses) == {"delayed", "compensated", "no delay"}, explorer.numbers
+    for text in mses.values():
+        digits = text.replace(".", "").lstrip("0")
+        assert len(digits) >= 3 and "e" not in text, explorer.numbers
+    if delay == 0.0:
+        assert len(set(mses.values())) == 1, explorer.numbers
+    else:
+        assert len(set(mses.values())) == 3, explorer.numbers
+    assert "(the pack's engine)" in explorer.numbers
 
 
 def test_draw_function_clears_a_foreign_figure():
@@ -385,7 +409,7 @@ def test_the_explorer_draws_the_students_numbers_not_the_engines():
     expected = _independent(DEFAULT.delay, noise)
     skip = max(DEFAULT.burn_in_steps, expected["steps"])
     shifted = expected["lines"]["prediction"][skip:] + 3.0 - DEFAULT.truth[skip:, 0]
-    assert f"compensated {np.mean(shifted ** 2):.2f} cm²" in theirs.numbers
+    assert f"compensated {three_figures(np.mean(shifted ** 2))} cm²" in theirs.numbers
 
 
 def test_functions_not_saved_yet_say_so_in_one_line(tmp_path, monkeypatch):

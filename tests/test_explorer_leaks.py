@@ -160,8 +160,8 @@ TASK_VALUES = [
     ("03_fusion", fusion.draw_fusion, {"sigma_v": 1.5, "sigma_p": 1.5}, "0.160"),
     ("04_noisier_proprioception", noisier_proprioception.draw_noisier_proprioception,
      {"sigma_p": 4.5}, "10.0"),
-    ("05_sensory_delay", delay.draw_delay, {"delay": 0.1}, "4.99"),
 ]
+# 05 is not here: its tasks print no one-run MSE (its explorer's numbers line) any more.
 
 
 @pytest.mark.parametrize(("name", "draw", "values", "answer"), TASK_VALUES,

@@ -123,6 +123,7 @@ def test_delay_figure_draws_the_four_series_and_shades_the_start():
         np.testing.assert_array_equal(lines[3].get_ydata(), truth + 0.05)
         assert ax_start.get_xlim() == pytest.approx((0.0, 0.5))
         assert ax_fast.get_xlim() == pytest.approx((0.4, 0.6))
+        assert ax_fast.get_title() == "Fast flight, 0.4–0.6 s"   # says where, not what
         shaded = ax_start.patches[0].get_extents().transformed(ax_start.transData.inverted())
         assert shaded.x0 == pytest.approx(0.0) and shaded.x1 == pytest.approx(0.1)
     finally:

@@ -53,7 +53,7 @@ from .bias_further import (
     check_dead_reckoning,
     check_sigma_a_sweep,
 )
-from .delay import check_compensation, check_delay_difference, check_delay_mse
+from .delay import check_compensation, check_delay_difference, check_delay_signals
 from .delay_further import check_late_eye, check_short_delays
 from .delay_sweep import (
     check_compensation_regimes,
@@ -134,7 +134,7 @@ __all__ = [
     "check_covariance_step",
     "check_dead_reckoning",
     "check_delay_difference",
-    "check_delay_mse",
+    "check_delay_signals",
     "check_delay_sweep",
     "check_equivalent_sensor",
     "check_error_sources",

@@ -2,8 +2,8 @@
 
 - :func:`check_compensation` (Task 1): the student's ``compensate`` on random cases,
   against the pack's :func:`lqe_helpers.prediction.predict_ahead`;
-- :func:`check_delay_mse` (Task 2): the late readings, the delayed and the compensated
-  position of one run and their MSEs, recomputed from the scenario's draw with the engine;
+- :func:`check_delay_signals` (Task 2): the late readings, the delayed and the
+  compensated position of one run, recomputed from the scenario's draw with the engine;
 - :func:`check_delay_difference` (Task 3): the paired delayed − compensated difference
   over the Monte Carlo runs and the share of the delay's cost won back, recomputed with
   :mod:`lqe_helpers.experiments`.
@@ -25,12 +25,11 @@ from ..scenario import DEFAULT
 from ..simulation import delay_signal
 from . import compensation_cases
 from .compensation_cases import COMPENSATE_ARGS, COMPENSATION_MISTAKES, Case, mistaken
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .judging import interval_mistakes, judge_interval
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
     MISTAKE_RTOL,
-    MSE_RTOL,
     CheckFailed,
     argument_array,
     call_student,
@@ -195,25 +194,22 @@ def _check_zero_delay(compensate: Callable, name: str, case: Case) -> None:
 # Task 2: one run, delayed and compensated
 # ------------------------------------------------------------------------------------------
 
-_NAN_HINT = ("the first δ samples of a delayed or compensated estimate are NaN (nothing has "
-             "arrived yet): leave out the first max(burn, δ) samples")
 _SIGNALS = ("late_readings", "delayed", "compensated")
 
 
 @functools.cache
 def _trial() -> dict[str, object]:
-    """Task 2 recomputed: the three signals (n,) (cm), the two MSEs (cm²), their mistakes."""
+    """Task 2 recomputed: the three signals (n,) (cm) and each one's likely mistakes."""
     tracking = experiments.track(DEFAULT)
     estimates, readings = tracking.result.estimates, tracking.measurements
-    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
+    truth = DEFAULT.truth[:, 0]
     steps = DEFAULT.delay_steps(DEFAULT.delay)
-    skip = max(burn, steps)
 
-    def late(x: np.ndarray, shift: int = steps) -> np.ndarray:
-        return delay_signal(x, shift)[:, 0]
+    def late(x: np.ndarray, shift: int = steps, column: int = 0) -> np.ndarray:
+        return delay_signal(x, shift)[:, column]
 
-    def ahead(x: np.ndarray, shift: int = steps) -> np.ndarray:
-        return predict_ahead(x, DEFAULT.A, shift)[:, 0]
+    def ahead(x: np.ndarray, shift: int = steps, column: int = 0) -> np.ndarray:
+        return predict_ahead(x, DEFAULT.A, shift)[:, column]
 
     def rolled(x: np.ndarray) -> np.ndarray:
         return np.roll(x, steps, axis=0)[:, 0]
@@ -225,12 +221,16 @@ def _trial() -> dict[str, object]:
     wrapped = ("it was shifted with np.roll, which wraps the last δ samples round to the "
                "start: nothing has arrived before j = δ, so those samples must be NaN "
                "(simulation.delay_signal does this)")
+    velocities = ("it holds velocities (column 1 of the states, cm/s), not positions: the "
+                  "position is column 0")
     signal_mistakes = {
         "late_readings": {
             "it is not delayed: these are the readings as they were taken, y_j. At time j "
                 "the observer has only y_(j−δ)": readings[:, 0],
             wrapped: rolled(readings),
             "it holds the delayed estimate, not the delayed readings": signals["delayed"],
+            "it holds the true position seen late, not the noisy readings y seen late":
+                delay_signal(truth, steps, axis=-1),
             **{cause: late(readings, shift) for cause, shift in off_by_one.items()},
         },
         "delayed": {
@@ -239,6 +239,7 @@ def _trial() -> dict[str, object]:
             wrapped: rolled(estimates),
             "it holds the late readings, not the delayed estimate": signals["late_readings"],
             "it holds the compensated estimate, not the delayed one": signals["compensated"],
+            velocities: late(estimates, column=1),
             **{cause: late(estimates, shift) for cause, shift in off_by_one.items()},
         },
         "compensated": {
@@ -247,38 +248,11 @@ def _trial() -> dict[str, object]:
                 (delay_signal(estimates, 2 * steps) @ np.linalg.matrix_power(
                     DEFAULT.A, steps).T)[:, 0],
             "it holds the delayed estimate, not the compensated one": signals["delayed"],
+            velocities: ahead(estimates, column=1),
             **{cause: ahead(estimates, shift) for cause, shift in off_by_one.items()},
         },
     }
-
-    def mse(x: np.ndarray, start: int = skip) -> float | None:
-        with np.errstate(invalid="ignore"):
-            value = float(np.mean((x[start:] - truth[start:]) ** 2))
-        return value if np.isfinite(value) else None
-
-    common = {
-        "it is the MSE of the filter's estimate without any delay: shift the estimates δ "
-        "samples later first": mse(estimates[:, 0]),
-        "it is the MSE of the late readings, not of an estimate":
-            mse(signals["late_readings"]),
-    }
-    mse_mistakes_by_kind = {
-        "compensated": {
-            "it is the MSE of the delayed estimate, not of the compensated one":
-                mse(signals["delayed"]),
-            **common, **mse_mistakes(signals["compensated"], truth, skip, dt)},
-        "delayed": {
-            "it is the MSE of the compensated estimate, not of the delayed one":
-                mse(signals["compensated"]),
-            **common, **mse_mistakes(signals["delayed"], truth, skip, dt)},
-    }
-    for kind, mistakes in mse_mistakes_by_kind.items():
-        mistakes[f"it leaves out only the first δ = {steps} samples; leave out the burn-in "
-                 f"too, max(burn, δ) = {skip}"] = (mse(signals[kind], steps) if steps < skip
-                                                    else None)
-    return {"signals": signals, "signal_mistakes": signal_mistakes, "steps": steps,
-            "mse": {kind: mse(signals[kind]) for kind in mse_mistakes_by_kind},
-            "mse_mistakes": mse_mistakes_by_kind}
+    return {"signals": signals, "signal_mistakes": signal_mistakes, "steps": steps}
 
 
 def _judge_signal(name: str, value: object, right: np.ndarray, steps: int,
@@ -300,6 +274,12 @@ def _judge_signal(name: str, value: object, right: np.ndarray, steps: int,
         if close(got, wrong, MISTAKE_RTOL) and not close(right, wrong, MISTAKE_RTOL):
             raise CheckFailed(f"{name} is not right: {cause}")
     nan = np.isnan(got)
+    if name != "late_readings" and nan[steps:].all():
+        raise CheckFailed(
+            f"{name} is NaN at every sample, also after j = δ = {steps}: was your my_filter "
+            f"run on the late readings? Their first δ samples are NaN, and a filter fed one "
+            f"NaN gives NaN from then on. Run it on the readings y as they were taken, then "
+            f"shift its estimates δ samples later")
     if not np.array_equal(nan, np.isnan(right)):
         raise CheckFailed(
             f"{name} must be NaN in exactly its first δ = {steps} samples (nothing has "
@@ -311,9 +291,9 @@ def _judge_signal(name: str, value: object, right: np.ndarray, steps: int,
         f"mistakes: was it made from your my_filter's estimates of the trial's readings y?")
 
 
-def check_delay_mse(late_readings: np.ndarray, delayed: np.ndarray, compensated: np.ndarray,
-                    mse_delayed_run: float, mse_compensated_run: float) -> None:
-    """Check Task 2: the three signals of one delayed run and the MSEs of its two estimates.
+def check_delay_signals(late_readings: np.ndarray, delayed: np.ndarray,
+                        compensated: np.ndarray) -> None:
+    """Check Task 2: the late readings and the delayed and compensated positions of one run.
 
     Recomputed from the task's own inputs before looking at the student's: the
     vision-only filter of eq. (5) on the scenario's draw (the pack's engine, which the
@@ -321,38 +301,28 @@ def check_delay_mse(late_readings: np.ndarray, delayed: np.ndarray, compensated:
     δ = ``DEFAULT.delay`` / Δt samples (:func:`lqe_helpers.simulation.delay_signal`) and
     compensated (:func:`lqe_helpers.prediction.predict_ahead`). Each signal's positions
     (n,) must agree within :data:`FUNCTION_RTOL` of its largest value, NaN exactly in the
-    first δ samples; each MSE (cm², after the first max(burn-in, δ) samples) within
-    :data:`MSE_RTOL` relative.
+    first δ samples.
 
     Parameters
     ----------
     late_readings, delayed, compensated : array_like, shape (n,)
         The student's y_(j−δ), ẑ_(j−δ) and z*_j positions (cm) on the wall-clock axis.
-    mse_delayed_run, mse_compensated_run : float
-        The student's MSEs (cm²).
 
     Raises
     ------
     CheckFailed
-        Naming the value and the likely cause: a signal not delayed, wrapped round by
-        np.roll or a sample off, the delayed estimates compensated, two swapped, whole
-        states for positions; an MSE over NaN samples, of the wrong estimate, the RMSE, ...
+        Naming the signal and the likely cause: not delayed, wrapped round by np.roll or
+        a sample off, the delayed estimates compensated, two swapped, the true position
+        for the readings, velocities or whole states for positions, the filter run on
+        the late readings (NaN throughout), ...
     """
     right = _trial()
     for name, value in zip(_SIGNALS, (late_readings, delayed, compensated), strict=True):
         _judge_signal(name, value, right["signals"][name], right["steps"],
                       right["signal_mistakes"][name])
-    for name, value, kind in (("mse_delayed_run", mse_delayed_run, "delayed"),
-                              ("mse_compensated_run", mse_compensated_run, "compensated")):
-        judge(name, value, right["mse"][kind], MSE_RTOL, unit="cm²", nan_hint=_NAN_HINT,
-              what=f"the {kind} position's MSE recomputed from the task's inputs",
-              mistakes=right["mse_mistakes"][kind])
-    steps = right["steps"]
-    passed(f"the late readings, the delayed and the compensated position (δ = {steps} "
-           f"samples) match the pack's engine on the scenario's draw to "
-           f"{tolerance_text(FUNCTION_RTOL)}, and their MSEs (after the first "
-           f"{max(DEFAULT.burn_in_steps, steps)} samples) to {tolerance_text(MSE_RTOL)} "
-           f"relative")
+    passed(f"the late readings, the delayed and the compensated position (δ = "
+           f"{right['steps']} samples) match the pack's engine on the scenario's draw to "
+           f"{tolerance_text(FUNCTION_RTOL)} of each signal's largest value")
 
 
 # ------------------------------------------------------------------------------------------
@@ -400,9 +370,10 @@ def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -
     ------
     CheckFailed
         With the likely cause: the sign reversed, an unpaired interval, the filter
-        without delay in place of one of the two, a ratio, one MSE alone; for the
-        share, the share of the delayed MSE, the share left, a ratio upside down, per
-        cent, ...
+        without delay in place of one of the two, a ratio, one MSE alone, the share for
+        the difference; for the share, the share of the delayed MSE, the share left, a
+        ratio upside down, per cent, the undelayed MSE as the cost, parentheses missing,
+        the difference for the share, ...
     """
     runs = monte_carlo_mses()
     delayed, predicted, now = runs["delayed"], runs["predicted"], runs["now"]
@@ -415,6 +386,9 @@ def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -
             metrics.mean_ci95(predicted - now),
         "it is the interval of the ratio delayed / compensated; the task asks for the paired "
         "difference delayed − compensated": metrics.mean_ci95(delayed / predicted),
+        "it is the share of the delay's cost won back (a fraction), which is won_back; gain "
+        "is the paired difference delayed − compensated in cm²":
+            metrics.mean_ci95((delayed - predicted) / (delayed - now)),
     }
     judge_interval("gain", gain, metrics.mean_ci95(delayed - predicted), INTERVAL_RTOL,
                    unit="cm²", what="the paired difference delayed − compensated MSE "
@@ -436,6 +410,20 @@ def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -
             metrics.Interval(100 * right.mean, 100 * right.low, 100 * right.high, right.runs),
         "it divides by compensated − undelayed; the delay's cost is delayed − undelayed":
             metrics.mean_ci95(won / (predicted - now)),
+        "it divides by the undelayed MSE; the delay's cost is what the delay adds to it, "
+        "delayed − undelayed": metrics.mean_ci95(won / now),
+        "it is compensated / delayed, the share of the delayed MSE that is left; the task "
+        "asks for (delayed − compensated) / (delayed − undelayed)":
+            metrics.mean_ci95(predicted / delayed),
+        "the numerator's parentheses are missing: only the compensated MSE is divided. "
+        "Write (delayed − compensated) / (delayed − undelayed)":
+            metrics.mean_ci95(delayed - predicted / cost),
+        "the denominator's parentheses are missing: it divides by the delayed MSE, then "
+        "subtracts the undelayed one. Write (delayed − compensated) / (delayed − undelayed)":
+            metrics.mean_ci95(won / delayed - now),
+        "it is the paired difference delayed − compensated in cm², which is gain; won_back "
+        "is the share of the delay's cost, (delayed − compensated) / (delayed − undelayed)":
+            metrics.mean_ci95(won),
     }
     judge_interval("won_back", won_back, right, INTERVAL_RTOL,
                    what="the share (delayed − compensated) / (delayed − undelayed) per run, "

@@ -16,8 +16,8 @@ def delay_figure(times: np.ndarray, truth: np.ndarray, delayed_readings: np.ndar
     """Question (e): truth, late readings, late estimate and compensated estimate.
 
     Top: the whole trial. Bottom left: the start, with the first ``delay`` seconds
-    (nothing has arrived yet) shaded. Bottom right: a window of fast flight, where the
-    late estimate trails most visibly.
+    (nothing has arrived yet) shaded. Bottom right: a window of fast flight, titled with
+    its times only (what it shows is the student's to find).
 
     Parameters
     ----------
@@ -68,7 +68,7 @@ def delay_figure(times: np.ndarray, truth: np.ndarray, delayed_readings: np.ndar
     ax_start.axvspan(times[0], times[0] + delay, color=COLORS["vision"], alpha=0.25,
                      linewidth=0)
     ax_start.set_title(f"Start: nothing before t = d = {delay:g} s (shaded)")
-    ax_fast.set_title("Fast flight: where the delay shows most")
+    ax_fast.set_title(f"Fast flight, {fast_window[0]:g}–{fast_window[1]:g} s")
     return fig
 
 
