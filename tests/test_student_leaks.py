@@ -17,8 +17,10 @@ there should be none).
    normalised the same way: for example a Summary or "What you will learn" cell that
    repeats the answer's conclusion.
 
-2. **A result printed by a solution cell.** Every number in the saved text outputs of
-   every cell tagged ``solution`` (printed text, and the plain-text, Markdown or HTML
+2. **A result printed from the first task on.** Every number in the saved text outputs
+   of the first cell tagged ``solution`` and of every code cell after it (a task's own
+   output, and a given cell that prints or draws from what the tasks computed; printed
+   text, and the plain-text, Markdown or HTML
    form of displayed results such as tables and figure descriptions; images are not
    text) is a *result* if it has at least three significant digits
    (:func:`significant_digits`: leading zeros never count, trailing zeros of a whole
@@ -145,13 +147,14 @@ def code_literals(notebook: nbformat.NotebookNode) -> set[Decimal]:
 
 
 def printed_results(notebook: nbformat.NotebookNode) -> dict[Decimal, str]:
-    """Results printed by solution cells (see the module docstring): value → where printed."""
+    """Results printed from the first solution cell on (see the module docstring): value →
+    where printed."""
     allowed = {number_value(token) for token in numbers(question_text(notebook))}
     allowed |= code_literals(notebook)
     found: dict[Decimal, str] = {}
-    for index, cell in enumerate(notebook.cells):
-        if se.SOLUTION_TAG not in tags(cell):
-            continue
+    first_task = next((index for index, cell in enumerate(notebook.cells)
+                       if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
+    for index, cell in enumerate(notebook.cells[first_task:], start=first_task):
         for output in cell.get("outputs", []):
             for value in results(output_text(output)) - allowed:
                 found.setdefault(value, se.cell_place("source", index, cell))
@@ -289,6 +292,17 @@ def test_a_leak_is_found_and_placed(cell, expected):
     assert len(leaks) == 1
     assert leaks[0].startswith("student, cell 5 (")
     assert expected in leaks[0]
+
+
+def test_a_result_a_given_cell_prints_after_the_task_leaks_if_typed_before_it():
+    """Bookkeeping moved out of a task (a given cell printing a ratio of the task's MSEs)
+    still prints a result; a number typed before the task may not give it away."""
+    given = new_code_cell("print(f'{100 * 0.3831 / 0.6442:.1f} %')", execution_count=2,
+                          outputs=[new_output("stream", name="stdout", text="59.5 %\n")])
+    notebook = leak_fixture(given)
+    notebook.cells.insert(1, new_markdown_cell("Filtering keeps 59.5 % of the error."))
+    leaks = find_leaks(notebook, student_of(notebook, "given"))
+    assert [leak.split(" contains ")[1].split(",")[0] for leak in leaks] == ["59.5"]
 
 
 def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
