@@ -35,6 +35,9 @@ def test_check_fusion_passes_the_worked_solution(capsys) -> None:
      "row 1 (proprioception) is [0.0, 1.0, 0.0], which reads velocity v"),
     (C_FUSED, np.diag([1.5, 4.5]), "R holds the standard deviations"),
     (C_FUSED, np.diag([20.25, 2.25]), "R's rows are swapped"),
+    (C_FUSED, np.diag([2.25, 4.5]), "R's proprioception entry holds σ = 4.5 cm, not the "
+                                    "variance σ² = 20.25 cm²"),
+    (C_FUSED, np.diag([1.5, 20.25]), "R's vision entry holds σ = 1.5 cm"),
     (C_FUSED, np.array([[2.25, 6.75], [6.75, 20.25]]), "R has off-diagonal entries"),
     (C_FUSED, np.array([2.25, 20.25]), "R has shape (2,): a vector"),
     (C_FUSED, np.diag([2.25, 20.25, 1.0]), "R must have shape (2, 2)"),
@@ -84,6 +87,8 @@ def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
         vision = reference.lqe_filter(y[:, 1:], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]
     if mistake == "velocity":
         fused = fused_all[:, 1]
+    if mistake == "velocity in both":
+        fused, vision = fused_all[:, 1], vision_all[:, 1]
     if mistake == "averaged readings":
         fused = reference.lqe_filter(y.mean(axis=1, keepdims=True), A, C[:1], Q, R[:1, :1], z0,
                                      P0)[:, 0]
@@ -136,6 +141,12 @@ def test_check_fusion_trial_names_each_realistic_mistake(mistake: str, phrase: s
     assert_fails(phrase, checks.check_fusion_trial, *task2(mistake))
 
 
+def test_check_fusion_trial_names_a_slip_made_in_both_filters_for_both() -> None:
+    message = assert_fails("vision_positions is not right: it is column 1 of the estimates, "
+                           "the velocity", checks.check_fusion_trial, *task2("velocity in both"))
+    assert "Also, fused_positions is not right: it is column 1 of the estimates" in message
+
+
 def test_check_fusion_trial_refuses_what_is_not_a_position_array() -> None:
     vision, fused, mse_vision, mse_fused = task2()
     assert_fails("vision_positions must be the estimated positions (cm), an array of shape "
@@ -153,20 +164,18 @@ def test_check_fusion_trial_refuses_what_is_not_a_position_array() -> None:
 # ------------------------------------------------------------------------------------------
 
 
-def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object, object]:
+def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object]:
     """Task 3 as a student writes it, optionally with one slip."""
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
     vision_mc = experiments.track(DEFAULT, ("vision",), runs=runs)
     fused_mc = experiments.track(DEFAULT, FUSED, runs=runs)
-    start = 1 if mistake == "burn-in in seconds" else burn
+    start = {"burn-in in seconds": 1, "whole trial": 0}.get(mistake, burn)
     mse_vision = metrics.mse(vision_mc.positions, truth, start)
     mse_fused = metrics.mse(fused_mc.positions, truth, start)
-    whole_vision = metrics.mse(vision_mc.positions, truth)
-    whole_fused = metrics.mse(fused_mc.positions, truth)
     difference = metrics.mean_ci95(mse_vision - mse_fused)
-    whole_difference = metrics.mean_ci95(whole_vision - whole_fused)
-    if mistake == "windows swapped":
-        difference, whole_difference = whole_difference, difference
+    if mistake == "whole-trial difference":
+        difference = metrics.mean_ci95(metrics.mse(vision_mc.positions, truth)
+                                       - metrics.mse(fused_mc.positions, truth))
     if mistake == "fused minus vision":
         difference = metrics.mean_ci95(mse_fused - mse_vision)
     if mistake == "two intervals combined":
@@ -174,44 +183,55 @@ def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object, object]:
         difference = metrics.Interval(alone_v.mean - alone_f.mean, alone_v.low - alone_f.high,
                                       alone_v.high - alone_f.low, runs)
     if mistake == "percent":
-        whole_difference = metrics.mean_ci95(100 * (whole_vision - whole_fused) / whole_vision)
+        difference = metrics.mean_ci95(100 * (mse_vision - mse_fused) / mse_vision)
+    if mistake == "ratio":
+        difference = metrics.mean_ci95(mse_vision / mse_fused)
     if mistake == "means only":
         difference = mse_vision.mean() - mse_fused.mean()
     if mistake == "one run":
         mse_vision = float(metrics.mse(vision_mc.positions[0], truth, burn))
-    if mistake == "whole-trial MSEs":
-        mse_vision, mse_fused = whole_vision, whole_fused
-    return mse_vision, mse_fused, difference, whole_difference
+    if mistake == "swapped":
+        mse_vision, mse_fused = mse_fused, mse_vision
+    return mse_vision, mse_fused, difference
 
 
 def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
     line = assert_passes(capsys, checks.check_fusion_difference, *task3())
     assert "over 300 runs match the pack's engine to 1e-6" in line
-    assert "after the first second and over the whole trial" in line
+    assert "the paired difference vision only − fused after the first second" in line
 
 
 @pytest.mark.parametrize(("mistake", "phrase"), [
-    ("windows swapped", "difference is not right: it is the difference over the whole trial"),
+    ("whole-trial difference", "difference is not right: it is the difference over the whole "
+                               "trial"),
     ("fused minus vision", "difference is not right: the sign is reversed"),
     ("two intervals combined", "difference is not right: it combines the two separate "
                                "intervals"),
-    ("percent", "whole_difference is not right: it is the relative difference in % of the "
+    ("percent", "difference is not right: it is the relative difference in % of the "
                 "vision-only MSE"),
+    ("ratio", "difference is not right: it is the interval of the ratio vision only / fused"),
     ("means only", "difference is a number; it must be the metrics.Interval"),
     ("one run", "mse_vision is one number; the task asks for one MSE per run, shape (300,)"),
-    ("whole-trial MSEs", "mse_vision is not right: it is the MSE of the whole trial"),
+    ("whole trial", "mse_vision is not right: it is the MSE of the whole trial"),
     ("burn-in in seconds", "mse_vision is not right: it leaves out the first 1 sample(s)"),
+    ("swapped", "mse_vision is not right: these are the fused filter's MSEs"),
 ])
 def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_fusion_difference, *task3(mistake))
 
 
+def test_check_fusion_difference_names_a_slip_made_in_both_filters_for_both() -> None:
+    message = assert_fails("mse_vision is not right: it is the MSE of the whole trial",
+                           checks.check_fusion_difference, *task3("whole trial"))
+    assert "Also, mse_fused is not right: it is the MSE of the whole trial" in message
+
+
 def test_check_fusion_difference_uses_the_vision_only_runs_of_the_same_noise() -> None:
     """Pairing is what the check recomputes: vision-only runs on another draw fail."""
-    _, mse_fused, _, whole_difference = task3()
+    _, mse_fused, _ = task3()
     other = experiments.track(dataclasses.replace(DEFAULT, seed=DEFAULT.seed + 1), ("vision",),
                               runs=DEFAULT.mc_runs)
     unpaired = metrics.mse(other.positions, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
     assert_fails("mse_vision does not match the vision-only MSEs recomputed from the task's "
                  "runs", checks.check_fusion_difference, unpaired, mse_fused,
-                 metrics.mean_ci95(unpaired - mse_fused), whole_difference)
+                 metrics.mean_ci95(unpaired - mse_fused))

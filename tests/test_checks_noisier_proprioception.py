@@ -34,41 +34,103 @@ def model():
 
 
 # ------------------------------------------------------------------------------------------
+# Task 1: σ_p and R
+# ------------------------------------------------------------------------------------------
+
+
+def task1(slip: str = "") -> tuple[float, np.ndarray]:
+    """Task 1 as a student writes it, with one ``slip``."""
+    sigma_v = SIGMA_V
+    sigma_p = {"sigma_p squared": 4.5**2, "question (c)": 1.5, "factor": 3.0,
+               "three variances": 3 * sigma_v**2}.get(slip, 4.5)
+    R = np.diag([sigma_v**2, sigma_p if slip == "sigma_p squared" else sigma_p**2])
+    if slip == "sigmas in R":
+        R = np.diag([sigma_v, sigma_p])
+    if slip == "variance times three":
+        R = np.diag([sigma_v**2, 3 * sigma_v**2])
+    if slip == "swapped":
+        R = np.diag([sigma_p**2, sigma_v**2])
+    if slip == "sigma_p in R":
+        R = np.diag([sigma_v**2, sigma_p])
+    return sigma_p, R
+
+
+def test_check_noisier_sense_passes_the_worked_answer(capsys) -> None:
+    line = assert_passes(capsys, checks.check_noisier_sense, *task1())
+    assert "σ_p = 4.5 cm and R = diag(σ_v², σ_p²) = diag(2.25, 20.25) cm²" in line
+
+
+@pytest.mark.parametrize(("slip", "phrase"), [
+    # The trial's slip: σ_p typed as its variance, with an R that is right.
+    ("sigma_p squared", "sigma_p = 20.25 cm is not right: it is σ_p² = 20.25 cm², a variance"),
+    ("question (c)", "sigma_p = 1.5 cm is not right: it is question (c)'s σ_p"),
+    ("factor", "sigma_p = 3 cm is not right: it is the factor 3 alone"),
+    ("three variances", "sigma_p = 6.75 cm is not right: it is three times vision's variance"),
+    ("sigmas in R", "R holds the standard deviations σ_v = 1.5 and σ_p = 4.5 cm"),
+    ("variance times three", "R's proprioceptive variance is three times vision's"),
+    ("swapped", "R's rows are swapped"),
+    ("sigma_p in R", "R's proprioception entry holds σ = 4.5 cm, not the variance σ² = "
+                     "20.25 cm²"),
+])
+def test_check_noisier_sense_names_the_cause(slip: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_noisier_sense, *task1(slip))
+
+
+def test_check_noisier_sense_wants_a_number_and_a_matrix() -> None:
+    assert_fails("sigma_p must be one number (cm), got None", checks.check_noisier_sense, None,
+                 np.diag([2.25, 20.25]))
+    assert_fails("R must be the noise covariance (cm²), an array of shape (2, 2), got None",
+                 checks.check_noisier_sense, 4.5, None)
+
+
+# ------------------------------------------------------------------------------------------
 # Task 2: one trial with the student's filter
 # ------------------------------------------------------------------------------------------
 
 
-def task2(slip: str = "") -> tuple[float, float]:
+def task2(slip: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     """Task 2 as a student writes it, with the student's filter, and one ``slip``."""
     A, C, Q, z0, P0, R = model()
     y = experiments.track(DEFAULT, FUSED, sigmas=[SIGMA_V, SIGMA_P]).measurements
     my_filter = reference.lqe_filter
-    fused_positions = my_filter(y, A, C, Q, R, z0, P0)[:, 0]
+    column = 1 if slip in ("velocity", "velocity in the fused") else 0
+    if slip == "sigmas in R":
+        R = np.diag([SIGMA_V, SIGMA_P])
+    fused_positions = my_filter(y, A, C, Q, R, z0, P0)[:, column]
     seen = y[:, 1:] if slip == "proprioception column" else y[:, :1]
     r_vision = R[1:, 1:] if slip == "R of proprioception" else R[:1, :1]
-    vision_positions = my_filter(seen, A, C[:1], Q, r_vision, z0, P0)[:, 0]
+    vision_column = 1 if slip == "velocity" else 0
+    vision_positions = my_filter(seen, A, C[:1], Q, r_vision, z0, P0)[:, vision_column]
     if slip == "raw readings":
         vision_positions = y[:, 0]
+    if slip == "swapped":
+        vision_positions, fused_positions = fused_positions, vision_positions
     burn = {"whole trial": 0, "burn-in in seconds": int(DEFAULT.burn_in)}.get(slip, BURN)
     mse_fused_trial = metrics.mse(fused_positions, TRUTH, burn)
     mse_vision_trial = metrics.mse(vision_positions, TRUTH, burn)
     if slip == "rmse":
         mse_fused_trial = np.sqrt(mse_fused_trial)
-    if slip == "swapped":
-        return mse_fused_trial, mse_vision_trial
-    return mse_vision_trial, mse_fused_trial
+    if slip == "MSEs swapped":
+        mse_vision_trial, mse_fused_trial = mse_fused_trial, mse_vision_trial
+    return vision_positions, fused_positions, mse_vision_trial, mse_fused_trial
 
 
 def test_check_noisier_trial_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_noisier_trial, *task2())
-    assert "σ_v = 1.5 cm, σ_p = 4.5 cm, after the first 100 samples" in line
+    assert "(σ_v = 1.5 cm, σ_p = 4.5 cm) match the pack's engine on the task's trial" in line
+    assert "both MSEs (after the first 100 samples) to 1e-6 relative" in line
 
 
 @pytest.mark.parametrize(("slip", "phrase"), [
-    ("swapped", "mse_vision_trial = 0.273901 cm² is not right: it is the fused filter's MSE"),
+    ("velocity in the fused", "fused_positions is not right: it is column 1 of the estimates, "
+                              "the velocity (cm/s)"),
+    ("swapped", "vision_positions is not right: it is the fused filter's estimate"),
     ("proprioception column", "the vision-only filter was given proprioception's readings"),
     ("R of proprioception", "the vision-only filter's R holds proprioception's variance σ_p²"),
-    ("raw readings", "it is the MSE of vision's raw readings, not of a filtered estimate"),
+    ("sigmas in R", "vision_positions is not right: R holds σ (cm) where the variance σ²"),
+    ("raw readings", "vision_positions is not right: these are vision's readings"),
+    ("MSEs swapped", "mse_vision_trial = 0.273901 cm² is not right: it is the fused filter's "
+                     "MSE"),
     ("whole trial", "mse_vision_trial = 0.363507 cm² is not right"),
     ("whole trial", "it is the MSE of the whole trial: the first 100 samples"),
     ("burn-in in seconds", "the burn-in is 1 s, which is 100 samples"),
@@ -79,20 +141,41 @@ def test_check_noisier_trial_names_the_cause_of_wrong_science(slip: str, phrase:
     assert_fails(phrase, checks.check_noisier_trial, *task2(slip))
 
 
+def test_check_noisier_trial_names_the_velocity_column_for_both_filters() -> None:
+    """The trial's slip: est[:, 1] as the positions of both filters, named for both."""
+    message = assert_fails("vision_positions is not right: it is column 1 of the estimates, "
+                           "the velocity", checks.check_noisier_trial, *task2("velocity"))
+    assert "Also, fused_positions is not right: it is column 1 of the estimates" in message
+
+
+def test_check_noisier_trial_names_both_wrong_mses() -> None:
+    vision, fused, _, _ = task2()
+    message = assert_fails(
+        "mse_vision_trial = 0.363507 cm² is not right: it is the MSE of the whole trial",
+        checks.check_noisier_trial, vision, fused, metrics.mse(vision, TRUTH),
+        metrics.mse(fused, TRUTH))
+    assert "Also, mse_fused_trial" in message and message.count("the whole trial") == 2
+
+
 def test_check_noisier_trial_judges_against_the_engine_not_the_students_numbers() -> None:
     other = Scenario(seed=DEFAULT.seed + 1)
     trial = experiments.track(other, FUSED, sigmas=[SIGMA_V, SIGMA_P])
     alone = experiments.track(other, ("vision",), sigmas=[SIGMA_V])
-    assert_fails("does not match the vision-only filter's MSE recomputed from the task's "
-                 "inputs", checks.check_noisier_trial, float(alone.mse()), float(trial.mse()))
+    assert_fails("vision_positions does not match the vision-only filter's positions "
+                 "recomputed from the task's trial", checks.check_noisier_trial,
+                 alone.positions, trial.positions, float(alone.mse()), float(trial.mse()))
 
 
-def test_check_noisier_trial_wants_numbers() -> None:
-    vision, fused = task2()
+def test_check_noisier_trial_wants_positions_and_numbers() -> None:
+    vision, fused, mse_vision, mse_fused = task2()
     assert_fails("mse_fused_trial must be one number (cm²), got None",
-                 checks.check_noisier_trial, vision, None)
+                 checks.check_noisier_trial, vision, fused, mse_vision, None)
     assert_fails("mse_vision_trial must be one number (cm²), got an array of shape (2,)",
-                 checks.check_noisier_trial, np.array([vision, fused]), fused)
+                 checks.check_noisier_trial, vision, fused, np.array([mse_vision, mse_fused]),
+                 mse_fused)
+    assert_fails("fused_positions has shape (1000, 3): it holds 3 column(s) of estimates",
+                 checks.check_noisier_trial, vision, np.stack([fused] * 3, axis=-1),
+                 mse_vision, mse_fused)
 
 
 # ------------------------------------------------------------------------------------------
@@ -107,14 +190,15 @@ def task3(slip: str = ""):
     fused_mc = experiments.track(DEFAULT, FUSED, sigmas=sigmas, runs=RUNS)
     vision_mc = experiments.track(DEFAULT, ("vision",), sigmas=[SIGMA_V], runs=RUNS)
     mse_fused, mse_vision = fused_mc.mse(), vision_mc.mse()
-    whole_fused = metrics.mse(fused_mc.positions, TRUTH)
-    whole_vision = metrics.mse(vision_mc.positions, TRUTH)
+    if slip == "whole trial":
+        mse_fused = metrics.mse(fused_mc.positions, TRUTH)
+        mse_vision = metrics.mse(vision_mc.positions, TRUTH)
     difference = metrics.mean_ci95(mse_vision - mse_fused)
-    whole_difference = metrics.mean_ci95(whole_vision - whole_fused)
     if slip == "reversed":
         difference = metrics.mean_ci95(mse_fused - mse_vision)
-    if slip == "windows swapped":
-        difference, whole_difference = whole_difference, difference
+    if slip == "whole-trial difference":
+        difference = metrics.mean_ci95(metrics.mse(vision_mc.positions, TRUTH)
+                                       - metrics.mse(fused_mc.positions, TRUTH))
     if slip == "separate intervals":
         a, b = metrics.mean_ci95(mse_vision), metrics.mean_ci95(mse_fused)
         difference = metrics.Interval(a.mean - b.mean, a.low - b.high, a.high - b.low, a.runs)
@@ -122,30 +206,43 @@ def task3(slip: str = ""):
         difference = metrics.mean_ci95(100 * (mse_vision - mse_fused) / mse_vision)
     if slip == "difference of means":
         difference = mse_vision.mean() - mse_fused.mean()
-    return difference, whole_difference
+    if slip == "mean MSEs":
+        mse_vision = mse_vision.mean()
+    if slip == "swapped":
+        mse_vision, mse_fused = mse_fused, mse_vision
+    return mse_vision, mse_fused, difference
 
 
 def test_check_noisier_difference_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_noisier_difference, *task3())
-    assert "vision-only − fused MSE, paired over 300 runs" in line
+    assert "the paired difference vision-only − fused after the first second over 300 runs" in line
 
 
 @pytest.mark.parametrize(("slip", "phrase"), [
     ("reversed", "difference is not right: the sign is reversed"),
-    ("default sigmas", "the fused filter's σ_p is question (c)'s 1.5 cm"),
-    ("sigma_p squared", "σ_p² (cm²) was given where σ_p (cm) belongs"),
-    ("windows swapped", "difference is not right: it is the difference over the whole trial"),
+    ("default sigmas", "mse_fused is not right: the fused filter's σ_p is question (c)'s 1.5 cm"),
+    ("sigma_p squared", "mse_fused is not right: σ_p² (cm²) was given where σ_p (cm) belongs"),
+    ("variances", "mse_fused is not right: the σ² (cm²) were given where the σ (cm)"),
+    ("whole-trial difference", "difference is not right: it is the difference over the whole "
+                               "trial"),
     ("separate intervals", "it combines the two separate intervals"),
     ("percent", "it is in % of the vision-only MSE"),
     ("difference of means", "difference is a number; it must be the metrics.Interval"),
-    ("variances", "difference is not right: the σ² (cm²) were given where the σ (cm)"),
+    ("mean MSEs", "mse_vision is one number; the task asks for one MSE per run, shape (300,)"),
+    ("swapped", "mse_vision is not right: these are the fused filter's MSEs"),
 ])
 def test_check_noisier_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_noisier_difference, *task3(slip))
 
 
+def test_check_noisier_difference_names_the_whole_trial_for_both_filters() -> None:
+    message = assert_fails("mse_vision is not right: these are over the whole trial",
+                           checks.check_noisier_difference, *task3("whole trial"))
+    assert "Also, mse_fused is not right: these are over the whole trial" in message
+
+
 def test_check_noisier_difference_is_instant() -> None:
-    """Its first call runs the engine on four settings (its own and two mistakes')."""
+    """Its first call runs the engine on five settings (its own and three mistakes')."""
     from lqe_helpers.checks import noisier_proprioception
 
     arguments = task3()

@@ -25,6 +25,13 @@ from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT, Scenario
 from lqe_helpers.student_code import StudentCodeError, calling
 
+
+def _sig(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant figures, trailing zeros kept (numpy's formatter)."""
+    return np.format_float_positional(value, precision=digits, unique=False, fractional=False,
+                                      trim="k").rstrip(".")
+
+
 LINE_GIDS = {"vision readings", "proprioception readings", "truth", "vision-only", "fused",
              "vision-only error", "fused error"}
 
@@ -79,17 +86,19 @@ def _check_figure(figure: Figure, numbers: str, sigma_v: float, sigma_p: float,
     assert weights["weight vision"] == pytest.approx(share_v, rel=1e-9)
     assert weights["weight proprioception"] == pytest.approx(1 - share_v, rel=1e-9)
     texts = [text.get_text() for ax in figure.axes for text in ax.texts]
-    assert texts == [f"{100 * share_v:.0f} %", f"{100 * (1 - share_v):.0f} %"]
+    assert texts == [f"{_sig(100 * share_v, 2)} %", f"{_sig(100 * (1 - share_v), 2)} %"]
     # The numbers beside the figure carry both σ's and this trial's MSEs after the
     # burn-in; the figure has no title of its own and the right panel's never changes.
     skip = scenario.burn_in_steps
     mse_vision, mse_fused = (np.mean(expected[gid][skip:] ** 2)
                              for gid in ("vision-only error", "fused error"))
     assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
-                       f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
-                       f"fused {mse_fused:.3f} cm². Filter: {whose}."), numbers
+                       f"{scenario.burn_in:g} s: vision only {_sig(mse_vision, 4)} cm², "
+                       f"fused {_sig(mse_fused, 4)} cm². Filter: {whose}."), numbers
     assert figure.get_suptitle() == ""
     assert figure.axes[2].get_title() == SHARES_TITLE
+    # It says what is drawn, not the rule the shares follow (notebook 03's Going further 5).
+    assert "reliab" not in SHARES_TITLE and "∝" not in SHARES_TITLE
 
 
 def test_slider_conventions():
@@ -183,8 +192,8 @@ def test_only_the_shares_on_the_bars_change_among_the_figures_texts():
     share_v = 0.75**2 / (3.0**2 + 0.75**2)
     changed = [(old, new) for old, new in zip(before, _texts(explorer.figure), strict=True)
                if old != new]
-    assert changed == [("50 %", f"{100 * share_v:.0f} %"),
-                       ("50 %", f"{100 * (1 - share_v):.0f} %")]
+    assert changed == [("50 %", f"{_sig(100 * share_v, 2)} %"),
+                       ("50 %", f"{_sig(100 * (1 - share_v), 2)} %")]
     assert explorer.numbers != numbers
 
 

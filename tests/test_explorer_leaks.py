@@ -2,11 +2,12 @@
 
 Each explorer's default numbers line (the line between its sliders and its figure, also
 the caption of its static picture) and the texts of its figure are compared with every
-number printed by the cells tagged ``solution`` of its notebook, as saved in the
-executed notebook. Numbers that are the explorer's own inputs (its slider values, the
-scenario's constants) are givens, not answers. A number leaks when, rounded to the
-precision a solution printed, it gives that solution's number (so 0.304 leaks a
-printed 0.30). The explorers avoid it by showing another noise draw than the tasks
+number printed by the code cells of its notebook (the cells tagged ``solution`` and the
+given cells that print what a task computed), as saved in the executed notebook.
+Numbers that are the explorer's own inputs (its slider values, the scenario's
+constants) are givens, not answers. A number leaks when, rounded to the precision a
+cell printed, it gives that cell's number (so 0.304 leaks a printed 0.30). The
+explorers avoid it by showing another noise draw than the tasks
 (``Scenario.explorer_seed``) and, where a number does not depend on the noise, by
 starting near, not at, a task's value (00's σ_j, 04's σ_p).
 """
@@ -89,11 +90,14 @@ def reveals(shown: Printed, answer: Printed) -> bool:
 
 
 def solution_outputs(name: str) -> list[str]:
-    """The text every cell tagged ``solution`` of notebook ``name`` printed or displayed."""
+    """The text every code cell of notebook ``name`` but its explorer's printed or displayed.
+
+    A task need not print what it computed: a given cell after its check may do it.
+    """
     notebook = json.loads((NOTEBOOKS / f"{name}.ipynb").read_text(encoding="utf-8"))
     texts = []
     for cell in notebook["cells"]:
-        if cell["cell_type"] != "code" or "solution" not in cell["metadata"].get("tags", []):
+        if cell["cell_type"] != "code" or "explorer" in cell["metadata"].get("tags", []):
             continue
         for output in cell.get("outputs", []):
             if output["output_type"] == "stream":
@@ -157,7 +161,7 @@ TASK_VALUES = [
     ("00_background_model", background.draw_background,
      {"jerk_std": DEFAULT.process_jerk_std}, "0.29"),
     ("01_vision_only", vision.draw_vision, {"sigma_v": 1.5}, "2.04"),
-    ("03_fusion", fusion.draw_fusion, {"sigma_v": 1.5, "sigma_p": 1.5}, "0.160"),
+    ("03_fusion", fusion.draw_fusion, {"sigma_v": 1.5, "sigma_p": 1.5}, "0.1596"),
     ("04_noisier_proprioception", noisier_proprioception.draw_noisier_proprioception,
      {"sigma_p": 4.5}, "10.0"),
 ]

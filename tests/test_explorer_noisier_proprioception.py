@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import html
+import re
 
 import numpy as np
 import pytest
@@ -27,6 +28,12 @@ from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT, Scenario
 from lqe_helpers.steady_state import steady_state
 from lqe_helpers.student_code import StudentCodeError
+
+
+def _sig(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant figures, trailing zeros kept (numpy's formatter)."""
+    return np.format_float_positional(value, precision=digits, unique=False, fractional=False,
+                                      trim="k").rstrip(".")
 
 TRIAL_GIDS = {"truth", "vision-only", "fused", "vision-only error", "fused error"}
 ONE_ROW = np.array([[1.0, 0.0, 0.0]])
@@ -68,9 +75,9 @@ def _check_figure(figure: Figure, numbers: str, sigma_p: float, noise: np.ndarra
     mse_vision, mse_fused = (np.mean((estimate[skip:] - truth[skip:]) ** 2)
                              for estimate in (alone, both))
     assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
-                       f"{scenario.burn_in:g} s: vision only {mse_vision:.3f} cm², "
-                       f"fused {mse_fused:.3f} cm². Proprioception's weight in the steady "
-                       f"state: {100 * weight:.1f} %. Estimates from {whose}."), numbers
+                       f"{scenario.burn_in:g} s: vision only {_sig(mse_vision, 4)} cm², "
+                       f"fused {_sig(mse_fused, 4)} cm². Proprioception's weight in the "
+                       f"steady state: {_sig(100 * weight, 3)} %. Estimates from {whose}."), numbers
     assert figure.get_suptitle() == ""
     assert figure.axes[2].get_title() == THEORY_TITLE
 
@@ -234,7 +241,7 @@ def test_static_display_carries_the_picture_and_names_the_sliders():
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
-def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
+def test_theory_axis_has_plain_labels_and_the_numbers_keep_three_significant_figures():
     figure = fresh_figure()
     numbers = draw_noisier_proprioception(figure, sigma_p=30.0)
     theory_ax = figure.axes[2]
@@ -242,9 +249,12 @@ def test_theory_axis_has_plain_labels_and_the_weight_keeps_a_decimal():
     labels = [label.get_text() for label in theory_ax.get_xticklabels()]
     assert labels == ["0.3", "1", "3", "10", "30", "100"]
     assert theory_ax.get_xticklabels(minor=True) == []
-    # At σ_p = 30 cm proprioception still has a weight: 2.25 / (2.25 + 900) ≈ 0.25 %.
-    assert numbers.endswith("Proprioception's weight in the steady state: 0.2 %. Estimates "
+    # At σ_p = 30 cm proprioception still has a weight, 2.25 / (2.25 + 900) = 0.249 %, and
+    # the fused MSE differs from the vision-only one in the fourth significant figure.
+    assert numbers.endswith("Proprioception's weight in the steady state: 0.249 %. Estimates "
                             "from the pack's engine.")
+    vision, fused = re.findall(r"(?:vision only|fused) ([0-9.]+) cm²", numbers)
+    assert len(vision.replace("0.", "", 1)) == 4 and vision != fused
 
 
 # ------------------------------------------------------------------------------------------

@@ -62,3 +62,28 @@ def test_frequency_response_figure_refuses_what_it_cannot_draw(frequency, bad, m
     with pytest.raises(ValueError, match=message):
         figures.frequency_response_figure(frequency, given, marked=marked)
     plt.close("all")
+
+
+def test_fusion_trial_figure_puts_its_legend_above_the_data_under_the_title():
+    """The readings fill the top panel from edge to edge: a legend inside covered them."""
+    times = np.linspace(0.0, 10.0, 1001)
+    truth = 10 * np.sin(np.pi * times)
+    readings = np.stack([truth + 3.0, truth - 3.0], axis=-1)
+    fig = figures.fusion_trial_figure(times, truth, truth + 0.5, truth - 0.5,
+                                      readings=readings, title="σ_v = σ_p = 1.5 cm")
+    try:
+        fig.canvas.draw()
+        top = fig.axes[0]
+        legend = top.get_legend()
+        assert [text.get_text() for text in legend.get_texts()] == [
+            "vision readings", "proprioception readings", "true position", "vision only",
+            "vision + proprioception"]
+        renderer = fig.canvas.get_renderer()
+        panel = top.get_window_extent(renderer)
+        box = legend.get_window_extent(renderer)
+        title = top.title.get_window_extent(renderer)
+        assert box.y0 >= panel.y1 - 1          # above the data, not over it
+        assert title.y0 >= box.y1 - 1          # and under the title
+        assert fig.bbox.contains(box.x0, box.y0) and fig.bbox.contains(box.x1, box.y1)
+    finally:
+        plt.close(fig)

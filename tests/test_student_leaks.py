@@ -17,15 +17,15 @@ there should be none).
    normalised the same way: for example a Summary or "What you will learn" cell that
    repeats the answer's conclusion.
 
-2. **A result printed from the first task on.** Every number in the saved text outputs
-   of the first cell tagged ``solution`` and of every code cell after it (a task's own
-   output, and a given cell that prints or draws from what the tasks computed; printed
-   text, and the plain-text, Markdown or HTML
-   form of displayed results such as tables and figure descriptions; images are not
-   text) is a *result* if it has at least three significant digits
-   (:func:`significant_digits`: leading zeros never count, trailing zeros of a whole
-   number without a decimal point do not count, so ``1000`` and ``0.05`` have one,
-   ``1.26``, ``0.0421``, ``12.0`` and ``1974`` three or four) and its value is neither
+2. **A result printed by a code cell.** Every number in the saved text outputs of
+   every code cell but the explorers' (a cell tagged ``solution``, or a given cell that
+   prints what a task computed, as the notebooks do so that a task need not print;
+   printed text, and the plain-text, Markdown or HTML form of displayed results such as
+   tables and figure descriptions; images are not text) is a *result* if it has at
+   least three significant digits (:func:`significant_digits`: leading zeros never
+   count, trailing zeros of a whole number without a decimal point do not count, so
+   ``1000`` and ``0.05`` have one, ``1.26``, ``0.0421``, ``12.0`` and ``1974`` three or
+   four) and its value is neither
    among the numbers of the question's text nor typed as a number literal in the code
    of a solution cell (such a number is an input the author chose, like an assumed
    σ̃_p = 13.5 cm, not a result the code computed; a literal in an untagged cell is
@@ -147,14 +147,13 @@ def code_literals(notebook: nbformat.NotebookNode) -> set[Decimal]:
 
 
 def printed_results(notebook: nbformat.NotebookNode) -> dict[Decimal, str]:
-    """Results printed from the first solution cell on (see the module docstring): value →
-    where printed."""
+    """Results printed by code cells (see the module docstring): value → where printed."""
     allowed = {number_value(token) for token in numbers(question_text(notebook))}
     allowed |= code_literals(notebook)
     found: dict[Decimal, str] = {}
-    first_task = next((index for index, cell in enumerate(notebook.cells)
-                       if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
-    for index, cell in enumerate(notebook.cells[first_task:], start=first_task):
+    for index, cell in enumerate(notebook.cells):
+        if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+            continue
         for output in cell.get("outputs", []):
             for value in results(output_text(output)) - allowed:
                 found.setdefault(value, se.cell_place("source", index, cell))
@@ -305,6 +304,17 @@ def test_a_result_a_given_cell_prints_after_the_task_leaks_if_typed_before_it():
     assert [leak.split(" contains ")[1].split(",")[0] for leak in leaks] == ["59.5"]
 
 
+def test_a_result_a_given_cell_prints_for_a_task_leaks_too():
+    """A task need not print: a given cell after its check prints what it computed."""
+    given = new_code_cell("print(f'mean MSE {mse:.4f} cm²')", execution_count=2,
+                          outputs=[new_output("stream", name="stdout",
+                                              text="mean MSE 2.3456 cm²\n")])
+    notebook = leak_fixture(given, new_markdown_cell("## Summary\n\nWhy is it 2.3456 cm²?"))
+    leaks = find_leaks(notebook, student_of(notebook, "given"))
+    assert leaks == [f"{se.cell_place('student', 6, notebook.cells[5])} contains 2.3456, "
+                     f"printed by {se.cell_place('source', 4, notebook.cells[4])}"]
+
+
 def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
     notebook = leak_fixture(new_code_cell(
         "# Task: check that your MSE is 1.259 cm² and below 6.21 cm².\nx = 1",
@@ -349,7 +359,7 @@ def texts_leaks(texts: dict[str, str], sources: list[Path]) -> list[str]:
     """Where ``texts`` (name → Markdown) repeat a result or an answer of any notebook.
 
     The pack's README and STUDENT-PACK.md come before every task, so any result a
-    solution cell prints (:func:`printed_results`, excepting the question's own numbers
+    code cell prints (:func:`printed_results`, excepting the question's own numbers
     and typed inputs) or any sentence of a worked answer leaks there.
     """
     found = []

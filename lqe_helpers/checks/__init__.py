@@ -20,7 +20,8 @@ every ``check_…`` and the tolerances:
   ``background_jerk_choice``), ``vision`` (01, with ``filter_models``, ``vision_smoothers`` and
   ``vision_further`` for its Going further), ``initial_covariance`` (02, with
   ``initial_covariance_further``), ``fusion`` (03, with ``fusion_further``),
-  ``noisier_proprioception`` (04, with ``misjudged_noise``), ``delay`` (05, with
+  ``noisier_proprioception`` (04, with ``noisier_proprioception_further`` and
+  ``misjudged_noise``), ``delay`` (05, with
   ``compensation_cases``; its Going further in ``delay_sweep`` and ``delay_further``),
   ``bias`` (06; its Going further in ``bias_further``);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
@@ -98,8 +99,11 @@ from .machinery import (
 from .misjudged_noise import check_assumed_sweep, check_misjudged, check_misjudged_nis
 from .noisier_proprioception import (
     check_noisier_difference,
-    check_noisier_theory,
+    check_noisier_sense,
     check_noisier_trial,
+)
+from .noisier_proprioception_further import (
+    check_noisier_theory,
     check_proprioception_sweep,
     check_sweep_reading,
 )
@@ -160,6 +164,7 @@ __all__ = [
     "check_nis",
     "check_noise_free_fits",
     "check_noisier_difference",
+    "check_noisier_sense",
     "check_noisier_theory",
     "check_noisier_trial",
     "check_one_step_error",

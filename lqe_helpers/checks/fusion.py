@@ -4,8 +4,8 @@
 - :func:`check_fusion_trial` (Task 2): the student's filter run on one trial both ways,
   its estimated positions and their MSEs, recomputed from the task's draw with the engine;
 - :func:`check_fusion_difference` (Task 3): the per-run MSEs over the Monte Carlo runs and
-  the paired vision-only − fused differences after the first second and over the whole
-  trial, recomputed with :func:`lqe_helpers.experiments.track`.
+  the paired vision-only − fused difference after the first second, recomputed with
+  :func:`lqe_helpers.experiments.track`.
 
 The checks of the Going further tasks are in :mod:`lqe_helpers.checks.fusion_further`.
 """
@@ -13,6 +13,7 @@ The checks of the Going further tasks are in :mod:`lqe_helpers.checks.fusion_fur
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -35,6 +36,27 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 
 #: The fused filter's sensors, in the column order of its readings, C and R.
 FUSED = ("vision", "proprioception")
+
+
+def judge_together(*judgements: Callable[[], object]) -> None:
+    """Run every judgement; if any fails, fail once, naming each value that failed.
+
+    A slip made in two values (column 1 of both filters' estimates) is named for both at
+    once, not one at a time. Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
+
+    Raises
+    ------
+    CheckFailed
+        One line: the failures' messages in the order of ``judgements``.
+    """
+    failures = []
+    for judgement in judgements:
+        try:
+            judgement()
+        except CheckFailed as failure:
+            failures.append(str(failure).rstrip("."))
+    if failures:
+        raise CheckFailed(". Also, ".join(failures))
 
 
 def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
@@ -64,7 +86,7 @@ def check_fusion(C: np.ndarray, R: np.ndarray, sigma_v: float, sigma_p: float) -
     C = argument_array(C, "C", "the observation matrix, an array of shape (2, 3)")
     R = argument_array(R, "R", "the noise covariance (cm²), an array of shape (2, 2)")
     _check_fusion_C(C)
-    _check_fusion_R(R, sigma_v, sigma_p)
+    judge_noise_matrix(R, sigma_v, sigma_p)
     passed(f"C (2 × 3) reads the position p for vision and for proprioception, and "
            f"R = diag(σ_v², σ_p²) = diag({sigma_v**2:g}, {sigma_p**2:g}) cm² (2 × 2)")
 
@@ -96,8 +118,16 @@ def _check_fusion_C(C: np.ndarray) -> None:
             f"from the state [p, v, a], with weight 1")
 
 
-def _check_fusion_R(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
-    variances = np.array([sigma_v**2, sigma_p**2])
+def judge_noise_matrix(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
+    """Judge the student's R (2, 2) (cm²) against diag(σ_v², σ_p²) (Tutorial eq. (6)).
+
+    Within :data:`MATRIX_RTOL` relative; else CheckFailed naming the mistake: a vector,
+    the wrong shape, off-diagonal entries, the σ for the σ² (both or one), the rows
+    swapped, σ⁴.
+    Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
+    """
+    sigmas = np.array([sigma_v, sigma_p])
+    variances = sigmas**2
     if R.ndim < 2 and R.size == 2:
         raise CheckFailed(
             f"R has shape {R.shape}: a vector. R is a 2 × 2 covariance matrix with the "
@@ -119,15 +149,22 @@ def _check_fusion_R(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
             f"R has off-diagonal entries ({R[0, 1]:g}, {R[1, 0]:g}). Vision and "
             f"proprioception are independent (Tutorial eq. (6)): their covariances, the "
             f"off-diagonal entries, are 0")
-    if same(diag, np.array([sigma_v, sigma_p])):
+    if same(diag, sigmas):
         raise CheckFailed(
             f"R holds the standard deviations σ_v = {sigma_v:g} and σ_p = {sigma_p:g} cm. "
             f"R is a covariance: its diagonal holds variances, in cm²")
+    for entry, label in enumerate(FUSED):
+        mixed = variances.copy()
+        mixed[entry] = sigmas[entry]
+        if same(diag, mixed):
+            raise CheckFailed(
+                f"R's {label} entry holds σ = {sigmas[entry]:g} cm, not the variance σ² = "
+                f"{variances[entry]:g} cm²: R is a covariance, its diagonal holds variances")
     if same(diag, variances[::-1]):
         raise CheckFailed(
             "R's rows are swapped: row 0 must be vision's variance and row 1 "
             "proprioception's, in the same order as the rows of C")
-    if same(diag, np.array([sigma_v, sigma_p]) ** 4):
+    if same(diag, sigmas**4):
         raise CheckFailed("R's diagonal holds σ⁴: the variances σ² were squared again")
     raise CheckFailed(
         f"R's diagonal is {diag.tolist()} cm²; for σ_v = {sigma_v:g} cm and σ_p = "
@@ -206,8 +243,11 @@ def _trial() -> dict[str, object]:
             "mse_mistakes": mse_wrong}
 
 
-def _positions_answer(value: object, name: str, n: int) -> np.ndarray:
-    """The student's positions as an array, or CheckFailed naming a wrong shape."""
+def position_array(value: object, name: str, n: int) -> np.ndarray:
+    """The student's positions (n,) (cm) as an array, or CheckFailed naming a wrong shape.
+
+    Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
+    """
     array = argument_array(value, name, f"the estimated positions (cm), an array of shape "
                                         f"({n},)")
     if array.ndim == 2 and array.shape[0] == n:
@@ -245,18 +285,23 @@ def check_fusion_trial(vision_positions: np.ndarray, fused_positions: np.ndarray
     """
     right = _trial()
     n = DEFAULT.n_steps
-    for kind, name, value in (("vision", "vision_positions", vision_positions),
-                              ("fused", "fused_positions", fused_positions)):
-        judge(name, _positions_answer(value, name, n), right["positions"][kind],
+
+    def positions(kind: str, name: str, value: object) -> None:
+        judge(name, position_array(value, name, n), right["positions"][kind],
               FUNCTION_RTOL, unit="cm", mistakes=right["mistakes"][kind],
               what=f"the {'vision-only' if kind == 'vision' else 'fused'} filter's positions "
                    f"recomputed from the task's trial")
-    for kind, name, value in (("vision", "mse_vision_trial", mse_vision_trial),
-                              ("fused", "mse_fused_trial", mse_fused_trial)):
+
+    def mse(kind: str, name: str, value: object) -> None:
         judge(name, value, right["mse"][kind], MSE_RTOL, unit="cm²",
               mistakes=right["mse_mistakes"][kind],
               what=f"the {'vision-only' if kind == 'vision' else 'fused'} MSE recomputed "
                    f"from the task's trial")
+
+    judge_together(functools.partial(positions, "vision", "vision_positions", vision_positions),
+                   functools.partial(positions, "fused", "fused_positions", fused_positions))
+    judge_together(functools.partial(mse, "vision", "mse_vision_trial", mse_vision_trial),
+                   functools.partial(mse, "fused", "mse_fused_trial", mse_fused_trial))
     passed(f"both filters' positions match the pack's engine on the task's trial to "
            f"{tolerance_text(FUNCTION_RTOL)} of the largest, and both MSEs (after the first "
            f"{DEFAULT.burn_in_steps} samples) to {tolerance_text(MSE_RTOL)} relative")
@@ -301,37 +346,35 @@ def _per_run(value: object, name: str, runs: int) -> np.ndarray:
 
 
 def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
-                            difference: metrics.Interval,
-                            whole_difference: metrics.Interval) -> None:
-    """Check Task 3: per-run MSEs of both filters and their paired differences.
+                            difference: metrics.Interval) -> None:
+    """Check Task 3: per-run MSEs of both filters and their paired difference.
 
     Recomputed from the task's inputs before looking at the student's:
     ``DEFAULT.mc_runs`` runs of vision alone and of both senses
     (:func:`lqe_helpers.experiments.track`; run r of both on the same visual noise), the
     per-run MSEs after the first ``DEFAULT.burn_in_steps`` samples (each within
-    :data:`MSE_RTOL` relative) and over the whole trial, and ``metrics.mean_ci95`` of the
-    per-run differences vision only − fused in both windows (mean and ends within
-    :data:`INTERVAL_RTOL` of the interval's scale).
+    :data:`MSE_RTOL` relative), and ``metrics.mean_ci95`` of the per-run differences
+    vision only − fused (mean and ends within :data:`INTERVAL_RTOL` of the interval's
+    scale).
 
     Parameters
     ----------
     mse_vision, mse_fused : array_like, shape (runs,)
         The student's per-run MSEs (cm²) after the first second.
-    difference, whole_difference : metrics.Interval
-        The student's paired differences (cm²) after the first second and over the whole
-        trial.
+    difference : metrics.Interval
+        The student's paired difference (cm²) after the first second.
 
     Raises
     ------
     CheckFailed
-        Naming the value and the likely cause: the two filters swapped, the windows
-        swapped, the sign reversed, an unpaired interval, a ratio or a percentage, the
-        standard deviation for the standard error, one run, ...
+        Naming the value and the likely cause: the two filters swapped, the whole trial,
+        the sign reversed, an unpaired interval, a ratio or a percentage, the standard
+        deviation for the standard error, one run, ...
     """
     values = monte_carlo_mses()
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
-    for kind, other, name, value in (("vision", "fused", "mse_vision", mse_vision),
-                                     ("fused", "vision", "mse_fused", mse_fused)):
+
+    def per_run(kind: str, other: str, name: str, value: object) -> None:
         label = "vision-only" if kind == "vision" else "fused"
         judge(name, _per_run(value, name, runs), values[f"{kind}_after"], MSE_RTOL,
               unit="cm²", what=f"the {label} MSEs recomputed from the task's runs",
@@ -341,29 +384,29 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
                   "these are the MSEs of vision's raw readings, not of the filter's "
                   "estimates": values["raw"],
                   **mse_mistakes(values[kind], truth, burn, DEFAULT.dt)})
-    windows = {"after": ("difference", difference, "after the first second (from burn_in on)"),
-               "whole": ("whole_difference", whole_difference, "over the whole trial")}
-    for window, (name, interval, said) in windows.items():
-        vision, fused = values[f"vision_{window}"], values[f"fused_{window}"]
-        other = "whole" if window == "after" else "after"
-        mistakes = {
-            **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE"),
-            f"it is the difference {windows[other][2]}; {name} is the one {said}":
-                metrics.mean_ci95(values[f"vision_{other}"] - values[f"fused_{other}"]),
-            "it is the interval of the ratio vision only / fused; the task asks for the "
-            "paired difference vision only − fused (cm²)": metrics.mean_ci95(vision / fused),
-            "it is the relative difference in % of the vision-only MSE; the task asks for "
-            "the difference itself (cm²)": metrics.mean_ci95(100 * (vision - fused) / vision),
-        }
-        if window == "after" and "vision_seconds" in values:
-            mistakes[f"it leaves out the first {burn * DEFAULT.dt:g} sample(s): the burn-in "
-                     f"is {burn * DEFAULT.dt:g} s, which is {burn} samples"] = (
-                metrics.mean_ci95(values["vision_seconds"] - values["fused_seconds"]))
-        judge_interval(name, interval, metrics.mean_ci95(vision - fused), INTERVAL_RTOL,
-                       unit="cm²", mistakes=mistakes,
-                       what=f"the paired difference vision only − fused {said}, recomputed "
-                            f"from the task's runs")
+
+    judge_together(functools.partial(per_run, "vision", "fused", "mse_vision", mse_vision),
+                   functools.partial(per_run, "fused", "vision", "mse_fused", mse_fused))
+    vision, fused = values["vision_after"], values["fused_after"]
+    mistakes = {
+        **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE"),
+        "it is the difference over the whole trial; difference is the one after the first "
+        "second (from burn_in on)":
+            metrics.mean_ci95(values["vision_whole"] - values["fused_whole"]),
+        "it is the interval of the ratio vision only / fused; the task asks for the paired "
+        "difference vision only − fused (cm²)": metrics.mean_ci95(vision / fused),
+        "it is the relative difference in % of the vision-only MSE; the task asks for the "
+        "difference itself (cm²)": metrics.mean_ci95(100 * (vision - fused) / vision),
+    }
+    if "vision_seconds" in values:
+        mistakes[f"it leaves out the first {burn * DEFAULT.dt:g} sample(s): the burn-in is "
+                 f"{burn * DEFAULT.dt:g} s, which is {burn} samples"] = (
+            metrics.mean_ci95(values["vision_seconds"] - values["fused_seconds"]))
+    judge_interval("difference", difference, metrics.mean_ci95(vision - fused), INTERVAL_RTOL,
+                   unit="cm²", mistakes=mistakes,
+                   what="the paired difference vision only − fused after the first second, "
+                        "recomputed from the task's runs")
     passed(f"per-run MSEs of both filters over {runs} runs match the pack's engine to "
-           f"{tolerance_text(MSE_RTOL)} relative, and the paired differences vision only − "
-           f"fused after the first second and over the whole trial (mean and 95 % interval) "
-           f"to {tolerance_text(INTERVAL_RTOL)}")
+           f"{tolerance_text(MSE_RTOL)} relative, and the paired difference vision only − "
+           f"fused after the first second (mean and 95 % interval) to "
+           f"{tolerance_text(INTERVAL_RTOL)}")

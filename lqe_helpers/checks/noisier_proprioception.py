@@ -1,29 +1,33 @@
 """Checks of notebook 04, question (d): proprioception three times noisier than vision.
 
-Task 1 (C and R) uses :func:`lqe_helpers.checks.fusion.check_fusion`. Every other check
-recomputes what its task asks from the task's own inputs and draws (the scenario's seed,
-the pack's engine :func:`lqe_helpers.experiments.track`) before it looks at the student's
-value, and names the likely cause of a wrong one:
+Every check recomputes what its task asks from the question's values and the task's own
+draws (the scenario's seed, the pack's engine :func:`lqe_helpers.experiments.track`)
+before it looks at the student's value, and names the likely cause of a wrong one:
 
-- :func:`check_noisier_trial` (Task 2): one trial filtered both ways, the two MSEs;
-- :func:`check_noisier_difference` (Task 3): the paired vision-only − fused MSE over the
-  Monte Carlo runs, after the first second and over the whole trial;
-- Going further: :func:`check_noisier_theory` (1), :func:`check_proprioception_sweep` and
-  :func:`check_sweep_reading` (2); the checks of Going further 4 (a misjudged σ_p) are in
-  :mod:`lqe_helpers.checks.misjudged_noise`, which shares this module's Monte Carlo runs.
+- :func:`check_noisier_sense` (Task 1): σ_p itself and R;
+- :func:`check_noisier_trial` (Task 2): one trial filtered both ways, the positions and
+  the two MSEs;
+- :func:`check_noisier_difference` (Task 3): the per-run MSEs and the paired vision-only
+  − fused MSE over the Monte Carlo runs, after the first second;
+- Going further 1 and 2 are checked in
+  :mod:`lqe_helpers.checks.noisier_proprioception_further`, Going further 4 (a misjudged
+  σ_p) in :mod:`lqe_helpers.checks.misjudged_noise`; both share this module's Monte
+  Carlo runs.
 """
 
 from __future__ import annotations
 
 import functools
+from functools import partial
 
 import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from ..steady_state import SteadyState
+from .fusion import engine_positions, judge_noise_matrix, judge_together, position_array
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
+    FUNCTION_RTOL,
     INTERVAL_RTOL,
     MATRIX_RTOL,
     MSE_RTOL,
@@ -70,6 +74,7 @@ def paired(first: np.ndarray, second: np.ndarray) -> metrics.Interval:
     """The paired difference ``first − second`` (per run) with its 95 % interval."""
     return metrics.mean_ci95(first - second)
 
+
 def entries(name: str, values: object, keys: tuple[object, ...], what: str) -> dict:
     """The student's dict ``name``, which must hold ``keys``."""
     if not isinstance(values, dict):
@@ -105,71 +110,159 @@ def intervals(name: str, values: object, grid: str, size: int | None = None) -> 
 
 
 # ------------------------------------------------------------------------------------------
-# Task 2: one trial, filtered both ways
+# Task 1: the noisier sense
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
-def _trial() -> dict[str, tuple[float, dict[str, float | None]]]:
-    """The right MSE (cm²) of each filter on Task 2's trial, with its likely mistakes."""
-    trial = experiments.track(DEFAULT, FUSED, sigmas=[SIGMA_V, SIGMA_P])
-    y = trial.measurements
-    alone = experiments.filter_model(DEFAULT, ("vision",), [SIGMA_V])
-    vision, fused = alone.filter(y[:, :1]).estimates[:, 0], trial.positions
+def check_noisier_sense(sigma_p: float, R: np.ndarray) -> None:
+    """Check Task 1: the student's σ_p and their R for question (d).
 
-    def mse(x: np.ndarray) -> float:
-        return float(metrics.mse(x, TRUTH, BURN))
-
-    raw = {"it is the MSE of vision's raw readings, not of a filtered estimate": mse(y[:, 0]),
-           "it is the MSE of proprioception's raw readings, not of a filtered estimate":
-               mse(y[:, 1])}
-    wrong_r = experiments.filter_model(DEFAULT, ("vision",), [SIGMA_P])
-    return {
-        "vision": (mse(vision), {**raw,
-                   "it is the fused filter's MSE: the vision-only filter reads column 0 of the "
-                   "readings only, with row 0 of C and the top-left entry of R": mse(fused),
-                   "the vision-only filter was given proprioception's readings (column 1); "
-                   "vision's are column 0": mse(alone.filter(y[:, 1:]).estimates[:, 0]),
-                   "the vision-only filter's R holds proprioception's variance σ_p²; "
-                   "vision's σ_v² is the top-left entry of R":
-                       mse(wrong_r.filter(y[:, :1]).estimates[:, 0]),
-                   **mse_mistakes(vision, TRUTH, BURN, DEFAULT.dt)}),
-        "fused": (mse(fused), {**raw,
-                  "it is the vision-only filter's MSE: the fused filter reads both columns of "
-                  "the readings with your C and R": mse(vision),
-                  **mse_mistakes(fused, TRUTH, BURN, DEFAULT.dt)}),
-    }
-
-
-def check_noisier_trial(mse_vision_trial: float, mse_fused_trial: float) -> None:
-    """Check Task 2's MSEs of one trial filtered with vision alone and with both senses.
-
-    Recomputed before looking at the student's values: the scenario's trial at σ_v =
-    1.5 cm and σ_p = 4.5 cm (:func:`lqe_helpers.experiments.track`), filtered by the
-    pack's engine with P0 = diag(1, 1, 1) cm², both senses and vision alone (column 0
-    of the readings); each MSE (cm²) after the first ``DEFAULT.burn_in_steps`` samples
-    must agree within :data:`MSE_RTOL` relative.
+    Expected: ``sigma_p`` is question (d)'s σ_p = 4.5 cm (a standard deviation), within
+    :data:`MATRIX_RTOL` relative, and ``R = diag(σ_v², σ_p²) = diag(2.25, 20.25)`` cm²,
+    each entry within :data:`MATRIX_RTOL` relative.
 
     Parameters
     ----------
-    mse_vision_trial, mse_fused_trial : float
-        The student's MSEs (cm²).
+    sigma_p : float
+        The student's proprioceptive noise σ_p (cm).
+    R : array_like, shape (2, 2)
+        The student's sensor noise covariance (cm²).
 
     Raises
     ------
     CheckFailed
-        Naming the value and the likely cause: the two swapped, proprioception's readings
-        in the vision-only filter, σ_p² as vision's R, the raw readings, the whole trial,
-        the burn-in in seconds, the RMSE, ...
+        With the likely cause: σ_p² (cm²) given for σ_p, question (c)'s σ_p, the factor
+        3 alone, three times vision's variance; in R: the σ for the σ², a variance nine
+        times instead of three times vision's... (see
+        :func:`~lqe_helpers.checks.fusion.judge_noise_matrix`).
+    """
+    judge("sigma_p", sigma_p, SIGMA_P, MATRIX_RTOL, unit="cm",
+          what=f"question (d)'s σ_p = {SIGMA_P:g} cm", mistakes={
+              f"it is σ_p² = {SIGMA_P**2:g} cm², a variance. sigma_p is the standard deviation "
+              f"σ_p in cm; R holds its square": SIGMA_P**2,
+              f"it is question (c)'s σ_p; question (d) makes proprioception three times as "
+              f"noisy as vision's σ_v = {SIGMA_V:g} cm": SIGMA_P_C,
+              f"it is the factor 3 alone; σ_p is three times vision's σ_v = {SIGMA_V:g} cm":
+                  3.0,
+              f"it is three times vision's variance σ_v²; (d) makes the standard deviation "
+              f"three times σ_v = {SIGMA_V:g} cm": 3 * SIGMA_V**2,
+              "it is √4.5; σ_p itself is 4.5 cm (R holds its square)": np.sqrt(SIGMA_P)})
+    R = argument_array(R, "R", "the noise covariance (cm²), an array of shape (2, 2)")
+    if R.shape == (2, 2) and np.allclose(np.diag(R), [SIGMA_V**2, 3 * SIGMA_V**2],
+                                         rtol=MATRIX_RTOL, atol=0):
+        raise CheckFailed(
+            f"R's proprioceptive variance is three times vision's; (d) triples the standard "
+            f"deviation σ_p = 3 σ_v = {SIGMA_P:g} cm, so the variance is nine times "
+            f"vision's, σ_p² = {SIGMA_P**2:g} cm²")
+    judge_noise_matrix(R, SIGMA_V, SIGMA_P)
+    passed(f"σ_p = {SIGMA_P:g} cm and R = diag(σ_v², σ_p²) = diag({SIGMA_V**2:g}, "
+           f"{SIGMA_P**2:g}) cm² (2 × 2), each to {tolerance_text(MATRIX_RTOL)} relative")
+
+
+# ------------------------------------------------------------------------------------------
+# Task 2: one trial, filtered both ways
+# ------------------------------------------------------------------------------------------
+
+@functools.cache
+def _trial() -> dict[str, dict]:
+    """Task 2's right positions (n,) (cm) and MSEs (cm²) of each filter, with the likely
+    mistakes of each."""
+    y = experiments.track(DEFAULT, FUSED, sigmas=[SIGMA_V, SIGMA_P]).measurements
+    root = {"vision": [np.sqrt(SIGMA_V)], "fused": [np.sqrt(SIGMA_V), np.sqrt(SIGMA_P)]}
+    positions = {"vision": engine_positions(y[:, :1], [SIGMA_V]),
+                 "fused": engine_positions(y, [SIGMA_V, SIGMA_P])}
+    velocity = "it is column 1 of the estimates, the velocity (cm/s): the position is column 0"
+    sigma_for_variance = "R holds σ (cm) where the variance σ² (cm²) belongs"
+    raw = "these are vision's readings, not the filter's estimate"
+    mistakes = {
+        "vision": {
+            "it is the fused filter's estimate: the vision-only filter reads column 0 of the "
+            "readings only, with row 0 of C and the top-left entry of R": positions["fused"],
+            "the vision-only filter was given proprioception's readings (column 1); "
+            "vision's are column 0": engine_positions(y[:, 1:], [SIGMA_V]),
+            "the vision-only filter's R holds proprioception's variance σ_p²; vision's σ_v² "
+            "is the top-left entry of R": engine_positions(y[:, :1], [SIGMA_P]),
+            velocity: engine_positions(y[:, :1], [SIGMA_V], 1),
+            sigma_for_variance: engine_positions(y[:, :1], root["vision"]),
+            raw: y[:, 0],
+        },
+        "fused": {
+            "it is the vision-only filter's estimate: the fused filter reads both columns "
+            "of the readings with your C and R": positions["vision"],
+            velocity: engine_positions(y, [SIGMA_V, SIGMA_P], 1),
+            sigma_for_variance: engine_positions(y, root["fused"]),
+            f"it is the filter of question (c), σ_p = {SIGMA_P_C:g} cm; (d) sets σ_p = "
+            f"{SIGMA_P:g} cm": engine_positions(y, [SIGMA_V, SIGMA_P_C]),
+            raw: y[:, 0],
+        },
+    }
+
+    def mse(x: np.ndarray) -> float:
+        return float(metrics.mse(x, TRUTH, BURN))
+
+    mse_wrong = {}
+    for kind, other in (("vision", "fused"), ("fused", "vision")):
+        mse_wrong[kind] = {
+            f"it is the {'fused' if kind == 'vision' else 'vision-only'} filter's MSE":
+                mse(positions[other]),
+            "it is the MSE of vision's raw readings, not of a filtered estimate": mse(y[:, 0]),
+            "it is the MSE of proprioception's raw readings, not of a filtered estimate":
+                mse(y[:, 1]),
+            **{f"it comes from a wrong estimate: {cause}": mse(wrong)
+               for cause, wrong in mistakes[kind].items() if wrong is not positions[other]},
+            **mse_mistakes(positions[kind], TRUTH, BURN, DEFAULT.dt),
+        }
+    return {"positions": positions, "mistakes": mistakes,
+            "mse": {kind: mse(value) for kind, value in positions.items()},
+            "mse_mistakes": mse_wrong}
+
+
+def check_noisier_trial(vision_positions: np.ndarray, fused_positions: np.ndarray,
+                        mse_vision_trial: float, mse_fused_trial: float) -> None:
+    """Check Task 2: one trial filtered with vision alone and with both senses, and its MSEs.
+
+    Recomputed before looking at the student's values: the scenario's trial at σ_v =
+    1.5 cm and σ_p = 4.5 cm (:func:`lqe_helpers.experiments.track`), filtered by the
+    pack's engine with P0 = diag(1, 1, 1) cm², both senses and vision alone (column 0
+    of the readings). The positions (cm) must agree within :data:`FUNCTION_RTOL` of their
+    largest value, each MSE (cm²) after the first ``DEFAULT.burn_in_steps`` samples within
+    :data:`MSE_RTOL` relative. A slip in both filters is named for both.
+
+    Parameters
+    ----------
+    vision_positions, fused_positions : array_like, shape (n,)
+        The student's estimated positions (cm): column 0 of their filter's estimates.
+    mse_vision_trial, mse_fused_trial : float
+        The student's MSEs (cm²) after the burn-in.
+
+    Raises
+    ------
+    CheckFailed
+        Naming each wrong value and the likely cause: the velocity column, the two
+        swapped, proprioception's readings or σ_p² in the vision-only filter, σ where σ²
+        belongs, question (c)'s σ_p, the raw readings, the whole trial, the burn-in in
+        seconds, the RMSE, ...
     """
     right = _trial()
-    for name, value, kind in (("mse_vision_trial", mse_vision_trial, "vision"),
-                              ("mse_fused_trial", mse_fused_trial, "fused")):
-        expected, mistakes = right[kind]
-        judge(name, value, expected, MSE_RTOL, unit="cm²", mistakes=mistakes,
-              what=f"the {'vision-only' if kind == 'vision' else 'fused'} filter's MSE "
-                   f"recomputed from the task's inputs")
-    passed(f"both MSEs of the trial (σ_v = {SIGMA_V:g} cm, σ_p = {SIGMA_P:g} cm, after the "
-           f"first {BURN} samples) match the pack's engine on the scenario's draw to "
+    n = DEFAULT.n_steps
+    label = {"vision": "vision-only", "fused": "fused"}
+
+    def positions(kind: str, name: str, value: object) -> None:
+        judge(name, position_array(value, name, n), right["positions"][kind], FUNCTION_RTOL,
+              unit="cm", mistakes=right["mistakes"][kind],
+              what=f"the {label[kind]} filter's positions recomputed from the task's trial")
+
+    def mse(kind: str, name: str, value: object) -> None:
+        judge(name, value, right["mse"][kind], MSE_RTOL, unit="cm²",
+              mistakes=right["mse_mistakes"][kind],
+              what=f"the {label[kind]} filter's MSE recomputed from the task's inputs")
+
+    judge_together(partial(positions, "vision", "vision_positions", vision_positions),
+                   partial(positions, "fused", "fused_positions", fused_positions))
+    judge_together(partial(mse, "vision", "mse_vision_trial", mse_vision_trial),
+                   partial(mse, "fused", "mse_fused_trial", mse_fused_trial))
+    passed(f"both filters' positions (σ_v = {SIGMA_V:g} cm, σ_p = {SIGMA_P:g} cm) match the "
+           f"pack's engine on the task's trial to {tolerance_text(FUNCTION_RTOL)} of the "
+           f"largest, and both MSEs (after the first {BURN} samples) to "
            f"{tolerance_text(MSE_RTOL)} relative")
 
 
@@ -177,262 +270,77 @@ def check_noisier_trial(mse_vision_trial: float, mse_fused_trial: float) -> None
 # Task 3: many runs, paired
 # ------------------------------------------------------------------------------------------
 
-def check_noisier_difference(difference: metrics.Interval,
-                             whole_difference: metrics.Interval) -> None:
-    """Check Task 3's paired difference vision-only − fused MSE, after 1 s and whole trial.
+def check_noisier_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
+                             difference: metrics.Interval) -> None:
+    """Check Task 3's per-run MSEs and their paired difference vision-only − fused.
 
     Recomputed before looking at the student's values: ``DEFAULT.mc_runs`` runs of both
     filters on the scenario's draws (:func:`lqe_helpers.experiments.track`, σ_v = 1.5 cm,
-    σ_p = 4.5 cm, run r of both on the same visual noise) and ``metrics.mean_ci95`` of
-    the per-run differences, after the first second and over the whole trial; mean and
-    ends must agree within :data:`INTERVAL_RTOL` of the interval's scale.
+    σ_p = 4.5 cm, run r of both on the same visual noise), their per-run MSEs after the
+    first second (each within :data:`MSE_RTOL` relative) and ``metrics.mean_ci95`` of the
+    per-run differences (mean and ends within :data:`INTERVAL_RTOL` of the interval's
+    scale).
 
     Parameters
     ----------
-    difference, whole_difference : metrics.Interval
-        The student's paired differences (cm²) after the first second and whole trial.
+    mse_vision, mse_fused : array_like, shape (runs,)
+        The student's per-run MSEs (cm²) after the first second.
+    difference : metrics.Interval
+        The student's paired difference (cm²) after the first second.
 
     Raises
     ------
     CheckFailed
-        With the likely cause: the sign reversed, the runs unpaired, the two time windows
-        swapped, σ_p of question (c), σ_p² given as the noise, a percentage, ...
+        With the likely cause: the two filters swapped, one run, the whole trial, σ_p of
+        question (c), σ_p² given as the noise, the sign reversed, the runs unpaired, a
+        percentage, ...
     """
+    runs = DEFAULT.mc_runs
     vision = monte_carlo((SIGMA_V,))
     fused = monte_carlo((SIGMA_V, SIGMA_P))
     fused_c = monte_carlo((SIGMA_V, SIGMA_P_C))
     fused_squared = monte_carlo((SIGMA_V, SIGMA_P**2))
     both_squared = monte_carlo((SIGMA_V**2, SIGMA_P**2))
-    windows = ("after the first second", "over the whole trial")
-    for part, (name, value) in enumerate((("difference", difference),
-                                          ("whole_difference", whole_difference))):
-        first, second = vision[part], fused[part]
-        mistakes = {
-            **interval_mistakes(first, second, "the vision-only MSE", "the fused MSE"),
-            f"it is the difference {windows[1 - part]}; {name} is the one "
-            f"{windows[part]}": paired(vision[1 - part], fused[1 - part]),
-            f"the fused filter's σ_p is question (c)'s {SIGMA_P_C:g} cm; (d) sets σ_p = "
-            f"{SIGMA_P:g} cm": paired(first, fused_c[part]),
-            "σ_p² (cm²) was given where σ_p (cm) belongs: sigmas holds standard deviations":
-                paired(first, fused_squared[part]),
-            "the σ² (cm²) were given where the σ (cm) belong: sigmas holds standard "
-            "deviations": paired(first, both_squared[part]),
-            "it is in % of the vision-only MSE; the task asks for the difference in cm²":
-                metrics.mean_ci95(100 * (first - second) / first),
-        }
-        judge_interval(name, value, paired(first, second), INTERVAL_RTOL, unit="cm²",
-                       mistakes=mistakes, what=f"the paired difference vision-only − fused "
-                       f"MSE {windows[part]} recomputed from the task's inputs")
-    passed(f"vision-only − fused MSE, paired over {DEFAULT.mc_runs} runs after the first "
-           f"second and over the whole trial: means and 95 % intervals match the pack's "
-           f"engine on the scenario's draws to {tolerance_text(INTERVAL_RTOL)} relative")
+    sigma_causes = {
+        f"the fused filter's σ_p is question (c)'s {SIGMA_P_C:g} cm; (d) sets σ_p = "
+        f"{SIGMA_P:g} cm": fused_c,
+        "σ_p² (cm²) was given where σ_p (cm) belongs: sigmas holds standard deviations":
+            fused_squared,
+        "the σ² (cm²) were given where the σ (cm) belong: sigmas holds standard deviations":
+            both_squared,
+    }
 
+    def per_run(name: str, right: tuple[np.ndarray, np.ndarray],
+                other: tuple[np.ndarray, np.ndarray], other_name: str,
+                wrong: dict[str, tuple[np.ndarray, np.ndarray]], value: object) -> None:
+        array = argument_array(value, name, f"one MSE per run (cm²), an array of shape "
+                                            f"({runs},)")
+        if array.size == 1:
+            raise CheckFailed(f"{name} is one number; the task asks for one MSE per run, "
+                              f"shape ({runs},): .mse() of a result of {runs} runs gives them")
+        judge(name, array, right[0], MSE_RTOL, unit="cm²",
+              what="the per-run MSEs after the first second recomputed from the task's runs",
+              mistakes={f"these are the {other_name} filter's MSEs": other[0],
+                        "these are over the whole trial; the MSEs leave out the first second "
+                        "(the start-up)": right[1],
+                        **{cause: pair[0] for cause, pair in wrong.items()}})
 
-# ------------------------------------------------------------------------------------------
-# Going further 1: theory beside simulation
-# ------------------------------------------------------------------------------------------
-
-def _steady(sigmas: list[float]) -> SteadyState:
-    """The steady state of vision alone (one σ, cm) or of both senses (two)."""
-    sensors = FUSED[:len(sigmas)]
-    return experiments.filter_model(DEFAULT, sensors, sigmas).steady_state()
-
-
-def check_noisier_theory(theory_vision: float, theory_fused: float, weight_p: float) -> None:
-    """Check the steady-state position variances and proprioception's share of the gain.
-
-    Recomputed from the filters' models (:func:`lqe_helpers.experiments.filter_model`,
-    σ_v = 1.5 cm, σ_p = 4.5 cm) with :func:`lqe_helpers.steady_state.steady_state`: each
-    variance is ``estimate_covariance[0, 0]`` (cm²), ``weight_p = K∞[0, 1] / (K∞[0, 0] +
-    K∞[0, 1])``; each within :data:`MATRIX_RTOL` relative.
-
-    Parameters
-    ----------
-    theory_vision, theory_fused : float
-        The student's steady-state position variances (cm²).
-    weight_p : float
-        Proprioception's share of the settled position gain, a fraction.
-
-    Raises
-    ------
-    CheckFailed
-        With the likely cause: the prediction's P∞ for the estimate's variance, σ in R
-        where σ² belongs, a standard deviation, the Monte Carlo MSE, vision's share, the
-        raw gain, a percentage, ...
-    """
-    for name, value, sigmas in (("theory_vision", theory_vision, [SIGMA_V]),
-                                ("theory_fused", theory_fused, [SIGMA_V, SIGMA_P])):
-        steady = _steady(sigmas)
-        expected = steady.estimate_covariance[0, 0]
-        mistakes = {
-            "it is P∞[0, 0], the variance of the one-step prediction (.covariance); the "
-            "estimate's is that of (I − K∞C)P∞ (.estimate_covariance)": steady.covariance[0, 0],
-            "R holds σ (cm) where the variance σ² (cm²) belongs":
-                _steady(list(np.sqrt(sigmas))).estimate_covariance[0, 0],
-            "it is a standard deviation (cm); the task asks for the variance (cm²)":
-                np.sqrt(expected),
-            "it is the Monte Carlo MSE, not the steady state of eq. (5)":
-                monte_carlo(tuple(sigmas))[0].mean(),
-        }
-        if len(sigmas) == 2:
-            mistakes["it is the vision-only filter's; theory_fused is the fused filter's"] = \
-                _steady([SIGMA_V]).estimate_covariance[0, 0]
-            mistakes[f"σ_p is question (c)'s {SIGMA_P_C:g} cm"] = \
-                _steady([SIGMA_V, SIGMA_P_C]).estimate_covariance[0, 0]
-        judge(name, value, expected, MATRIX_RTOL, unit="cm²", mistakes=mistakes,
-              what="the steady-state position variance recomputed from the filter's model")
-    gain = _steady([SIGMA_V, SIGMA_P]).gain[0]
-    share = gain[1] / gain.sum()
-    judge("weight_p", weight_p, share, MATRIX_RTOL, what="proprioception's share of K∞[0]",
-          mistakes={
-              "it is vision's share: proprioception is column 1 of the gain": gain[0] / gain.sum(),
-              "it is K∞[0, 1] itself; its share divides by the row's sum K∞[0, 0] + K∞[0, 1]":
-                  gain[1],
-              "it is in %; the task asks for a fraction between 0 and 1": 100 * share})
-    passed(f"both steady-state position variances and proprioception's share of K∞[0] match "
-           f"steady_state of the filters' models to {tolerance_text(MATRIX_RTOL)} relative")
-
-
-# ------------------------------------------------------------------------------------------
-# Going further 2: the sweep over σ_p
-# ------------------------------------------------------------------------------------------
-
-def _theory_margin(dense: np.ndarray, sigma_v: float = SIGMA_V) -> np.ndarray:
-    """The steady-state improvement (%) of fusion over vision alone at each σ_p (cm)."""
-    level = _steady([SIGMA_V]).estimate_covariance[0, 0]
-    sigmas = np.stack([np.full_like(dense, sigma_v), dense], axis=-1)
-    fused = experiments.filter_model(DEFAULT, FUSED, sigmas).steady_state()
-    return 100 * (1 - fused.estimate_covariance[..., 0, 0] / level)
-
-
-def check_proprioception_sweep(sweep_sigma_p: np.ndarray, margin_by_sigma: list,
-                               dense_sigma_p: np.ndarray, theory_margin: np.ndarray) -> None:
-    """Check the sweep's paired improvement (%) and the theory's, against σ_p.
-
-    ``sweep_sigma_p`` must include 1.5 and 4.5 cm. The paired improvement
-    ``metrics.mean_ci95(100 (MSE_vision − MSE_fused) / MSE_vision)`` is recomputed with
-    the engine at three of its σ_p (the smallest, 1.5 and 4.5 cm; the full sweep would
-    take seconds) within :data:`INTERVAL_RTOL`; the theory on the whole ``dense_sigma_p``
-    from the steady states, within :data:`MATRIX_RTOL` relative.
-
-    Parameters
-    ----------
-    sweep_sigma_p : array_like, shape (S,)
-        The σ_p simulated (cm), increasing.
-    margin_by_sigma : list of metrics.Interval, length S
-        The paired improvement (%) at each σ_p.
-    dense_sigma_p, theory_margin : array_like, shape (T,)
-        The theory's σ_p (cm) and its improvement (%) at each.
-
-    Raises
-    ------
-    CheckFailed
-        With the likely cause: cm² instead of %, % of the fused MSE, the sign reversed, a
-        fraction, the whole trial, σ in R, the prediction's P∞, ...
-    """
-    grid = sigma_grid("sweep_sigma_p", sweep_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p", grid.size)
-    marks = [np.flatnonzero(np.isclose(grid, mark, rtol=1e-9, atol=0)) for mark in (1.5, 4.5)]
-    if not all(mark.size for mark in marks):
-        raise CheckFailed("sweep_sigma_p must include 1.5 and 4.5 cm, the σ_p of questions (c) "
-                          "and (d)")
-    vision, vision_whole = monte_carlo((SIGMA_V,))
-    for index in sorted({0, int(marks[0][0]), int(marks[1][0])}):
-        fused, fused_whole = monte_carlo((SIGMA_V, float(grid[index])))
-        judge_interval(
-            f"margin_by_sigma[{index}]", margins[index],
-            metrics.mean_ci95(100 * (vision - fused) / vision), INTERVAL_RTOL, unit="%",
-            what=f"the paired improvement at σ_p = {grid[index]:g} cm recomputed with the engine",
-            mistakes={
-                "it is the difference in cm²; the task asks for it in % of the vision-only MSE":
-                    paired(vision, fused),
-                "it is in % of the fused MSE; divide by the vision-only MSE":
-                    metrics.mean_ci95(100 * (vision - fused) / fused),
-                "the sign is reversed: the improvement is vision-only − fused":
-                    metrics.mean_ci95(100 * (fused - vision) / vision),
-                "it is a fraction; the task asks for %":
-                    metrics.mean_ci95((vision - fused) / vision),
-                "it is over the whole trial; the MSEs leave out the first second":
-                    metrics.mean_ci95(100 * (vision_whole - fused_whole) / vision_whole)})
-    dense = sigma_grid("dense_sigma_p", dense_sigma_p)
-    expected = _theory_margin(dense)
-    small = np.all(dense < 1e3)
-    judge("theory_margin", theory_margin, expected, MATRIX_RTOL, unit="%",
-          what="the steady-state improvement recomputed on dense_sigma_p", mistakes={
-              "the variances σ² went where the σ belong (the model squares them itself)":
-                  _theory_margin(dense**2, SIGMA_V**2) if small else None,
-              "σ_p² went where σ_p belongs (the model squares it itself)":
-                  _theory_margin(dense**2) if small else None,
-              "it is a fraction; the task asks for %": expected / 100,
-              "the sign is reversed: the improvement is 1 − fused / vision-only": -expected})
-    passed(f"the paired improvement at σ_p = {grid[0]:g}, 1.5 and 4.5 cm matches the engine "
-           f"to {tolerance_text(INTERVAL_RTOL)} relative, the theory at all "
-           f"{dense.size} σ_p matches the steady states to {tolerance_text(MATRIX_RTOL)}")
-
-
-def check_sweep_reading(better: int, worse: int, benefit_below: dict,
-                        margin_by_sigma: list, dense_sigma_p: np.ndarray) -> None:
-    """Check what the task read off the sweep: counts and where the benefit fades.
-
-    ``better`` and ``worse`` count the σ_p whose paired interval in ``margin_by_sigma``
-    (judged by :func:`check_proprioception_sweep`) lies entirely above or below zero;
-    ``benefit_below[level]`` is the first σ_p of ``dense_sigma_p`` (cm) from which the
-    steady-state improvement, recomputed from the theory, is below ``level`` % (10 and 1).
-    Counts exactly, σ_p within :data:`MATRIX_RTOL` relative.
-
-    Parameters
-    ----------
-    better, worse : int
-        The student's counts.
-    benefit_below : dict of int to float
-        σ_p (cm) keyed by the level (%), 10 and 1.
-    margin_by_sigma : list of metrics.Interval
-        The sweep's paired improvements (%), as the previous task made them.
-    dense_sigma_p : array_like, shape (T,)
-        The theory's σ_p (cm), increasing.
-
-    Raises
-    ------
-    CheckFailed
-        With the likely cause: a positive mean counted as significant, an interval that
-        reaches below zero counted as worse, σ_p in units of σ_v, the last σ_p above the
-        level, ...
-    """
-    dense = sigma_grid("dense_sigma_p", dense_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p")
-    try:
-        parts = np.array([[float(m.low), float(m.mean), float(m.high)] for m in margins])
-    except (AttributeError, TypeError, ValueError):
-        raise CheckFailed("margin_by_sigma must hold the metrics.Interval of each σ_p "
-                          "(check_proprioception_sweep passes it)") from None
-    low, mean, high = parts.T
-    judge("better", better, np.sum(low > 0), MSE_RTOL, unit="σ_p values", mistakes={
-        "it counts every positive mean; significantly better needs the whole interval above "
-        "zero (its low end > 0)": np.sum(mean > 0),
-        "it counts the σ_p where fusion is not significantly better": np.sum(low <= 0)},
-        what="the number of intervals entirely above zero")
-    judge("worse", worse, np.sum(high < 0), MSE_RTOL, unit="σ_p values", mistakes={
-        "it counts every interval that reaches below zero; significantly worse needs the "
-        "whole interval below zero (its high end < 0)": np.sum(low < 0),
-        "it counts every negative mean; significantly worse needs the whole interval below "
-        "zero (its high end < 0)": np.sum(mean < 0)},
-        what="the number of intervals entirely below zero")
-    crossings = entries("benefit_below", benefit_below, BENEFIT_LEVELS, "σ_p (cm)")
-    theory = _theory_margin(dense)
-    for level in BENEFIT_LEVELS:
-        below = np.flatnonzero(theory < level)
-        if below.size == 0 or below[0] == 0:
-            raise CheckFailed(f"dense_sigma_p must reach from below to above where the "
-                              f"benefit falls under {level} %")
-        first = below[0]
-        judge(f"benefit_below[{level}]", crossings[level], dense[first], MATRIX_RTOL,
-              unit="cm", what="the first σ_p of dense_sigma_p where the theory is below "
-              f"{level} %", mistakes={
-                  "it is σ_p in units of σ_v (σ_p / σ_v); the task asks for σ_p in cm":
-                      dense[first] / SIGMA_V,
-                  f"it is the last σ_p where the benefit is still above {level} %; the task "
-                  f"asks for the first where it is below": dense[first - 1]})
-    passed(f"the counts match the intervals ({int(np.sum(low > 0))} above zero, "
-           f"{int(np.sum(high < 0))} below) and the σ_p where the theory falls below "
-           f"{' and '.join(f'{level} %' for level in BENEFIT_LEVELS)} match the steady states "
-           f"to {tolerance_text(MATRIX_RTOL)} relative")
+    judge_together(partial(per_run, "mse_vision", vision, fused, "fused", {}, mse_vision),
+                   partial(per_run, "mse_fused", fused, vision, "vision-only", sigma_causes,
+                           mse_fused))
+    first, second = vision[0], fused[0]
+    mistakes = {
+        **interval_mistakes(first, second, "the vision-only MSE", "the fused MSE"),
+        "it is the difference over the whole trial; difference is the one after the first "
+        "second": paired(vision[1], fused[1]),
+        **{cause: paired(first, pair[0]) for cause, pair in sigma_causes.items()},
+        "it is in % of the vision-only MSE; the task asks for the difference in cm²":
+            metrics.mean_ci95(100 * (first - second) / first),
+    }
+    judge_interval("difference", difference, paired(first, second), INTERVAL_RTOL, unit="cm²",
+                   mistakes=mistakes, what="the paired difference vision-only − fused MSE "
+                   "after the first second recomputed from the task's inputs")
+    passed(f"both filters' per-run MSEs match the pack's engine to "
+           f"{tolerance_text(MSE_RTOL)} relative, and the paired difference vision-only − "
+           f"fused after the first second over {runs} runs (mean and 95 % interval) to "
+           f"{tolerance_text(INTERVAL_RTOL)} relative")

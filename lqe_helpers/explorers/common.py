@@ -102,15 +102,25 @@ def position_shares(gain: np.ndarray) -> np.ndarray:
     return row / row.sum()
 
 
+def significant(value: float, digits: int) -> str:
+    """``value`` to ``digits`` significant figures, trailing zeros kept.
+
+    E.g. 0.06251 → "0.06251" and 10 → "10.00" at 4 digits; 0.249 → "0.25" at 2. A
+    fixed number of decimals would print a small value as 0.00 at some slider settings.
+    """
+    return f"{value:#.{digits}g}".rstrip(".")
+
+
 def trial_numbers(scenario: Scenario, sigma_v: float, sigma_p: float,
                   vision: experiments.Tracking, fused: experiments.Tracking) -> str:
     """Both σ's (cm) and the trial's MSEs (cm²) after the burn-in, as one sentence.
 
-    E.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE of this trial after 1 s: vision only
-    0.304 cm², fused 0.274 cm²."
+    Each MSE to 4 significant figures, enough to tell the two apart at every σ of the
+    sliders, e.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE of this trial after 1 s: vision only
+    0.3041 cm², fused 0.2739 cm²."
     """
     return (
         f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
-        f"{scenario.burn_in:g} s: vision only {float(vision.mse()):.3f} cm², "
-        f"fused {float(fused.mse()):.3f} cm²."
+        f"{scenario.burn_in:g} s: vision only {significant(float(vision.mse()), 4)} cm², "
+        f"fused {significant(float(fused.mse()), 4)} cm²."
     )

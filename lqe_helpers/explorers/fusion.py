@@ -4,9 +4,9 @@ Two sliders set the noise of each sense. The left column shows one trial: the
 butterfly, both senses' readings and the two filters' estimates, with the
 estimation errors below. The right panel shows how the fused filter splits its
 trust between the senses once its gain has settled: the shares of the position
-correction, which follow the reliabilities ``1/σ_v²`` and ``1/σ_p²``, each printed on
-its bar. Both σ's and the trial's MSEs are not drawn in the figure: the drawing
-function returns them as one line of text, shown between the sliders and the picture.
+correction, each printed on its bar (to 2 significant figures). Both σ's and the
+trial's MSEs are not drawn in the figure: the drawing function returns them as one line
+of text, shown between the sliders and the picture.
 
 Given the student's own filter (``explore_fusion(filter=my_filter)``), the sliders run it
 for both estimates (through :func:`lqe_helpers.student_code.call`, so a hang is stopped
@@ -39,6 +39,7 @@ from .common import (
     estimate_lines,
     legend_handles,
     position_shares,
+    significant,
     trial_numbers,
 )
 from .panels import DATA_UNDER_LINES, pin_axis_labels, reuse_panels
@@ -65,8 +66,9 @@ _LINES: dict[str, TrialLine] = {
 }
 _BAND = "fused band"
 _BAND_LABEL = "fused filter's own ±2 SD"
-#: Title of the right panel; it never changes, so it stays in the cached background.
-SHARES_TITLE = "weights ∝ reliability 1/σ²"
+#: Title of the right panel; it never changes, so it stays in the cached background. It
+#: names what is drawn, not the rule the shares follow (Going further 5 of notebook 03).
+SHARES_TITLE = "each sense's share\nof the position gain"
 
 
 def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarray:
@@ -107,8 +109,8 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
     sense's share of the settled position gain, in % on its bar. Returns both σ's,
     this trial's MSEs after the scenario's burn-in and whose filter ran as one line of
     text (the explorer shows it beside the figure), e.g. "σ_v = 1.5 cm, σ_p = 2 cm. MSE
-    of this trial after 1 s: vision only 0.304 cm², fused 0.274 cm². Filter: your
-    my_filter."
+    of this trial after 1 s: vision only 0.4450 cm², fused 0.2786 cm². Filter: your
+    my_filter." (the explorer's draw).
 
     A figure this function drew before (for the same scenario) keeps its panels and
     only has its data replaced, which halves the redraw time of a slider; any other
@@ -189,7 +191,7 @@ def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
     panels.band.set_data(scenario.times, -2 * std, 2 * std)
     for bar, text, weight in zip(panels.bars, panels.texts, weights, strict=True):
         bar.set_height(weight)
-        text.set_text(f"{100 * weight:.0f} %")
+        text.set_text(f"{significant(100 * weight, 2)} %")
         text.xy = (bar.get_x() + bar.get_width() / 2, weight)
     return f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} Filter: {whose(filter)}."
 

@@ -39,6 +39,7 @@ from .common import (
     estimate_lines,
     legend_handles,
     position_shares,
+    significant,
     trial_numbers,
 )
 from .fusion import FUSED, unit_noise, vision_only
@@ -119,9 +120,9 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     ``sigma_p``. Returns both σ's, this trial's MSEs after the scenario's burn-in,
     proprioception's share of the settled position gain and whose filter made the
     estimates as one line of text (the explorer shows it beside the figure), e.g.
-    "σ_v = 1.5 cm, σ_p = 4.5 cm. MSE of this trial after 1 s: vision only 0.304 cm²,
-    fused 0.274 cm². Proprioception's weight in the steady state: 10.0 %. Estimates
-    from your my_filter."
+    "σ_v = 1.5 cm, σ_p = 6 cm. MSE of this trial after 1 s: vision only 0.4450 cm²,
+    fused 0.4200 cm². Proprioception's weight in the steady state: 5.88 %. Estimates
+    from your my_filter." (the explorer's draw).
 
     A figure this function drew before (for the same scenario) keeps its panels and
     only has its data replaced, which halves the redraw time of a slider; any other
@@ -146,8 +147,9 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     Returns
     -------
     str
-        Both σ's (cm), the trial's MSEs (cm²) of both filters after the burn-in,
-        proprioception's weight (%, one decimal) and whose filter it is.
+        Both σ's (cm), the trial's MSEs (cm²) of both filters after the burn-in (4
+        significant figures), proprioception's weight (%, 3 significant figures) and
+        whose filter it is.
 
     Notes
     -----
@@ -201,7 +203,7 @@ def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarr
         panels.trial.lines[gid].set_ydata(values)
     panels.marker.set_data([sigma_p], [theory_now])
     return (f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} "
-            f"Proprioception's weight in the steady state: {100 * weight_p:.1f} %. "
+            f"Proprioception's weight in the steady state: {significant(100 * weight_p, 3)} %. "
             f"Estimates from {whose(filter)}.")
 
 
