@@ -14,12 +14,13 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 
 import numpy as np
 
-from .. import experiments, metrics, model, simulation
+from .. import experiments, metrics, simulation
 from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
@@ -190,10 +191,14 @@ def _readings(sigma_v: float, scale: float | None = None) -> np.ndarray:
 
 
 def _filtered(readings: np.ndarray, r_variance: float) -> np.ndarray:
-    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]]."""
-    return kalman_filter(readings, DEFAULT.A, model.observation_matrix(("vision",)), DEFAULT.Q,
-                         np.array([[r_variance]]), np.asarray(DEFAULT.z0, dtype=float),
-                         DEFAULT.P0).estimates[:, 0]
+    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]].
+
+    The tasks' vision-only model (:func:`lqe_helpers.experiments.filter_model`) with its
+    R replaced, so that a slip in R (σ for σ², σ⁴) is filtered exactly as written.
+    """
+    vision = experiments.filter_model(DEFAULT)
+    return dataclasses.replace(vision, R=np.array([[r_variance]])).filter(
+        readings).estimates[:, 0]
 
 
 @functools.cache
