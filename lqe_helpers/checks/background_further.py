@@ -26,8 +26,9 @@ from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
     CheckFailed,
-    argument_array,
+    keyed_entries,
     passed,
+    shaped_argument,
     tolerance_text,
 )
 
@@ -43,30 +44,6 @@ SUB_STEPS = 1000
 
 def _sigma_j() -> float:
     return DEFAULT.process_jerk_std
-
-
-def shaped_argument(value: object, name: str, shape: tuple[int, ...], what: str) -> np.ndarray:
-    """The student's array of ``shape``, or CheckFailed naming it."""
-    return argument_array(value, name, f"{what}, an array of shape {shape}", shape=shape)
-
-
-def keyed_entries(values: object, name: str, keys: tuple, what: str) -> dict:
-    """The student's dict with an entry for each of ``keys`` (numbers compared as floats)."""
-    if not isinstance(values, Mapping):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by "
-                          f"{', '.join(repr(key) for key in keys)}, got {found}")
-    found_keys = {}
-    for key in values:
-        if isinstance(key, (int, float, np.number)) and not isinstance(key, bool):
-            found_keys[float(key)] = values[key]
-        else:
-            found_keys[key] = values[key]
-    missing = [key for key in keys if key not in found_keys]
-    if missing:
-        have = ", ".join(repr(key) for key in values) or "none"
-        raise CheckFailed(f"{name} has no entry {missing[0]!r} (its keys: {have})")
-    return {key: found_keys[key] for key in keys}
 
 
 # ------------------------------------------------------------------------------------------

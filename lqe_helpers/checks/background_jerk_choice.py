@@ -18,9 +18,16 @@ import numpy as np
 from .. import experiments, metrics
 from ..jerk_tuning import JerkChoice
 from ..scenario import DEFAULT
-from .background_further import keyed_entries, shaped_argument
 from .judging import judge
-from .machinery import MATRIX_RTOL, MSE_RTOL, CheckFailed, passed, tolerance_text
+from .machinery import (
+    MATRIX_RTOL,
+    MSE_RTOL,
+    CheckFailed,
+    keyed_entries,
+    passed,
+    shaped_argument,
+    tolerance_text,
+)
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 

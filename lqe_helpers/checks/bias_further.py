@@ -21,9 +21,17 @@ import numpy as np
 
 from .. import bias_model, experiments, metrics
 from ..scenario import DEFAULT
-from .background_further import keyed_entries, shaped_argument
 from .judging import interval_mistakes, judge, judge_interval
-from .machinery import INTERVAL_RTOL, MATRIX_RTOL, MSE_RTOL, CheckFailed, passed, tolerance_text
+from .machinery import (
+    INTERVAL_RTOL,
+    MATRIX_RTOL,
+    MSE_RTOL,
+    CheckFailed,
+    keyed_entries,
+    passed,
+    shaped_argument,
+    tolerance_text,
+)
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 

@@ -34,6 +34,7 @@ from .machinery import (
     CheckFailed,
     call_student,
     close,
+    keyed_entries,
     match_mistake,
     passed,
     require_callable,
@@ -265,22 +266,11 @@ def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS
     CheckFailed
         If ``values`` is not a dict, or a key due is missing.
     """
-    if not isinstance(values, dict):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by {key} ({unit}), e.g. "
-                          f"{name}[{keys[-1]:g}], got {found}")
-    found_keys = {}
-    for item in values:
-        if isinstance(item, (int, float, np.number)) and not isinstance(item, bool):
-            found_keys[float(item)] = values[item]
-    missing = [value for value in keys if value not in found_keys]
-    if missing:
-        have = ", ".join(repr(item) for item in values) or "none"
-        raise CheckFailed(f"{name} has no entry for {key} = {missing[0]:g} {unit} (its keys: "
-                          f"{have}); the task asks for {key} = "
-                          f"{', '.join(f'{value:g}' for value in keys)} {unit}, keyed by the "
-                          f"number {key} itself")
-    return found_keys
+    return keyed_entries(
+        values, name, keys, what, keyed_by=f"{key} ({unit}), e.g. {name}[{keys[-1]:g}]",
+        entry=lambda missing: f"for {key} = {missing:g} {unit}",
+        advice=f"; the task asks for {key} = {', '.join(f'{value:g}' for value in keys)} "
+               f"{unit}, keyed by the number {key} itself")
 
 
 def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float, float]) -> None:
