@@ -27,6 +27,7 @@ from .machinery import (
     MATRIX_RTOL,
     MSE_RTOL,
     CheckFailed,
+    interval_list,
     keyed_entries,
     passed,
     shaped_argument,
@@ -257,15 +258,6 @@ def _sweep() -> dict[str, object]:
     return found
 
 
-def _intervals(values: object, name: str, size: int) -> list:
-    if not isinstance(values, Sequence) or isinstance(values, str) or len(values) != size:
-        found = f"{len(values)} items" if isinstance(values, Sequence) else \
-            f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a list of {size} metrics.Interval, one per σ_a of "
-                          f"sigma_a_grid, got {found}")
-    return list(values)
-
-
 def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
                         sweep_paired: Sequence[metrics.Interval], sweep_rms: np.ndarray,
                         sweep_std: np.ndarray) -> None:
@@ -287,8 +279,8 @@ def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
     """
     right = _sweep()
     grid = sigma_a_grid()
-    mses = _intervals(sweep_mse, "sweep_mse", grid.size)
-    paired = _intervals(sweep_paired, "sweep_paired", grid.size)
+    mses = interval_list(sweep_mse, "sweep_mse", "σ_a of sigma_a_grid", grid.size)
+    paired = interval_list(sweep_paired, "sweep_paired", "σ_a of sigma_a_grid", grid.size)
     arrays = {name: shaped_argument(value, name, (grid.size,), "one value per σ_a (cm/s²)")
               for name, value in (("sweep_rms", sweep_rms), ("sweep_std", sweep_std))}
     for j, i in enumerate(SWEEP_CHECKED):

@@ -231,6 +231,28 @@ def _as_key(key: Hashable) -> Hashable:
     return float(key) if isinstance(key, (int, float, np.integer, np.floating)) else key
 
 
+def interval_list(values: object, name: str, one_per: str, size: int | None = None) -> list:
+    """The student's list (or tuple) ``name`` of intervals, one per value of a grid.
+
+    ``one_per`` says what each is for ("σ_a of sigma_a_grid"); ``size`` is how many the
+    grid has (None: any number but 0). The items are judged later
+    (:func:`~lqe_helpers.checks.judging.judge_interval`).
+
+    Raises
+    ------
+    CheckFailed
+        If ``values`` is not a list or tuple of that length.
+    """
+    is_list = isinstance(values, (list, tuple))
+    if not is_list or len(values) != ((len(values) or 1) if size is None else size):
+        found = (f"{len(values)} entries" if is_list
+                 else "None" if values is None else f"a {type(values).__name__}")
+        count = "" if size is None else f"{size} "
+        raise CheckFailed(f"{name} must be a list of {count}metrics.Interval, one per "
+                          f"{one_per}, got {found}")
+    return list(values)
+
+
 # ------------------------------------------------------------------------------------------
 # Comparing results
 # ------------------------------------------------------------------------------------------

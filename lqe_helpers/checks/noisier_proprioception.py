@@ -29,6 +29,7 @@ from .machinery import (
     MSE_RTOL,
     CheckFailed,
     argument_array,
+    interval_list,
     keyed_entries,
     passed,
     tolerance_text,
@@ -84,17 +85,6 @@ def sigma_grid(name: str, values: object) -> np.ndarray:
         raise CheckFailed(f"{name} must be a 1-D array of at least 3 increasing σ values > 0 "
                           f"(cm), got shape {grid.shape}")
     return grid
-
-
-def intervals(name: str, values: object, grid: str, size: int | None = None) -> list:
-    """The student's list of intervals, one per value of the grid ``grid`` (``size``)."""
-    if not isinstance(values, (list, tuple)) or len(values) != (size or len(values) or 1):
-        found = (f"{len(values)} entries" if isinstance(values, (list, tuple))
-                 else "None" if values is None else f"a {type(values).__name__}")
-        count = f"{size} " if size else ""
-        raise CheckFailed(f"{name} must be a list of {count}metrics.Interval, one per value "
-                          f"of {grid} in its order, got {found}")
-    return list(values)
 
 
 # ------------------------------------------------------------------------------------------
@@ -324,7 +314,8 @@ def check_proprioception_sweep(sweep_sigma_p: np.ndarray, margin_by_sigma: list,
         fraction, the whole trial, σ in R, the prediction's P∞, ...
     """
     grid = sigma_grid("sweep_sigma_p", sweep_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p", grid.size)
+    margins = interval_list(margin_by_sigma, "margin_by_sigma",
+                            "value of sweep_sigma_p in its order", grid.size)
     marks = [np.flatnonzero(np.isclose(grid, mark, rtol=1e-9, atol=0)) for mark in (1.5, 4.5)]
     if not all(mark.size for mark in marks):
         raise CheckFailed("sweep_sigma_p must include 1.5 and 4.5 cm, the σ_p of questions (c) "
@@ -392,7 +383,8 @@ def check_sweep_reading(better: int, worse: int, benefit_below: dict,
         level, ...
     """
     dense = sigma_grid("dense_sigma_p", dense_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p")
+    margins = interval_list(margin_by_sigma, "margin_by_sigma",
+                            "value of sweep_sigma_p in its order")
     try:
         parts = np.array([[float(m.low), float(m.mean), float(m.high)] for m in margins])
     except (AttributeError, TypeError, ValueError):
