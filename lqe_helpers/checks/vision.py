@@ -24,7 +24,7 @@ from .. import experiments, metrics, simulation
 from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
-from .filter_models import FILTER_MISTAKES, FILTER_STEPS, FilterModel
+from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
     FUNCTION_RTOL,
@@ -48,7 +48,6 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 #: The question's two noise levels of vision (cm).
 SIGMAS_V = (1.5, 4.5)
 
-_FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
 _FILTER_SHAPE_HINT = (
     "The shapes in one product or sum do not fit: write the shape beside each term (y_j is "
     "(m,), ẑ is (k,), C is (m, k), P and A are (k, k), R is (m, m), K is (k, m)).")
@@ -88,7 +87,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     for index, m in enumerate(models):
         try:
             output = call_student(my_filter, *m.args, name=name, where=m.describe(),
-                                  arg_names=_FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
+                                  arg_names=FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
                                   forbid=(kalman_filter,))
         except STOP_CALLING:
             raise
@@ -113,7 +112,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     _explain_wrong_rows(name, models[wrong[0]], answers[wrong[0]], correct[wrong[0]])
 
 
-def _explain_wrong_rows(name: str, m: FilterModel, answer: np.ndarray,
+def _explain_wrong_rows(name: str, m: FilterCase, answer: np.ndarray,
                         right: np.ndarray) -> None:
     """CheckFailed for a filter whose numbers differ in no typical way."""
     if answer.shape[0] > 1 and np.allclose(answer, answer[-1], rtol=0, atol=0) and \
@@ -139,7 +138,7 @@ def _explain_wrong_rows(name: str, m: FilterModel, answer: np.ndarray,
         f"{scale:.3g}.)")
 
 
-def _filter_output(output: object, name: str, m: FilterModel) -> np.ndarray:
+def _filter_output(output: object, name: str, m: FilterCase) -> np.ndarray:
     """The filter's output as an (n, k) array, or a CheckFailed naming what came back."""
     n, k = m.n, m.k
     what = f"the estimates ẑ, an array of shape (n, k) = {(n, k)}"
