@@ -24,17 +24,20 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 #: verdict and message every time it runs).
 SEED = 2026
 
-#: Relative tolerance of the function checks (:func:`check_filter`,
-#: :func:`check_compensation`), scaled by the largest entry of the correct result.
+#: Relative tolerance of what a student's function or filter run returns (the estimates of
+#: ``check_filter``, ``check_compensation``, ``check_smoother``, a trial's positions),
+#: scaled by the largest entry of the correct result.
 FUNCTION_RTOL = 1e-9
 
 #: Relative tolerance of a mean squared error, of the expected value's size.
 MSE_RTOL = 1e-6
 
-#: Relative tolerance of :func:`check_initial_covariance` and :func:`check_fusion`.
+#: Relative tolerance of a matrix or array the student computes as the check does (C, R,
+#: P0, A, a steady-state variance, an RMS curve): it agrees to rounding.
 MATRIX_RTOL = 1e-9
 
-#: Tolerance (s) of the convergence-time checks of notebook 02: a time is a whole number of samples.
+#: Tolerance (s) of a time read off a curve (a convergence or crossing time): a whole
+#: number of samples, so exact to rounding.
 TIME_ATOL = 1e-9
 
 #: Relative tolerance (of the interval's scale: its mean or half-width, whichever is
