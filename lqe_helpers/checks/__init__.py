@@ -26,7 +26,9 @@ every ``check_…`` and the tolerances:
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
-  mistakes of an MSE and of a paired difference.
+  mistakes of an MSE and of a paired difference;
+- ``shared_runs``: the engine's Monte Carlo runs that checks of several notebooks compare
+  with, made once per kernel.
 """
 
 from .background import (

@@ -38,6 +38,7 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -371,7 +372,7 @@ def _matching_runs() -> dict[str, dict[str, np.ndarray]]:
     """Per-run MSEs (runs,) of each matching time, with what the usual slips give."""
     truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
     noise = DEFAULT.unit_noise(DEFAULT.mc_runs, ("vision",))  # the task's draw, drawn once
-    default = experiments.track(DEFAULT, runs=DEFAULT.mc_runs, noise=noise)
+    default = vision_runs()  # the pack's σ_j on the same draw
     found = {}
     for key, fraction in PERIODS.items():
         sigma = matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency, dt, fraction)

@@ -31,6 +31,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -220,7 +221,7 @@ def _white() -> dict[str, object]:
     """Task D's Q_white and the paired % interval, recomputed, with wrong variants."""
     sigma_j, dt, M = _sigma_j(), DEFAULT.dt, SUB_STEPS
     right = white_jerk_q(sigma_j, dt, M)
-    runs = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    runs = vision_runs()
     truth, burn = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
 
     def mse_with(Q: np.ndarray, whole: bool = False) -> np.ndarray:

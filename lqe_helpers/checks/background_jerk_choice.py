@@ -28,6 +28,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -207,7 +208,7 @@ def _choice() -> dict[str, object]:
     is then applied to these arrays.
     """
     burn = DEFAULT.burn_in_steps
-    tracking = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    tracking = vision_runs()
     innovations = tracking.innovations()
     nu, S = innovations.values[..., 0], innovations.covariances[..., 0, 0]
     R = DEFAULT.sigma_v**2

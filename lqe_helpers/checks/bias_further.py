@@ -33,6 +33,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -50,7 +51,7 @@ def _monte_carlo() -> bias_model.InputTracking:
 @functools.cache
 def _vision_only() -> np.ndarray:
     """Per-run MSEs (runs,) of the vision-only filter on the same camera noise (cm²)."""
-    return experiments.track(DEFAULT, runs=DEFAULT.mc_runs, noise=_noise()[..., :1]).mse()
+    return vision_runs().mse()  # bias_model.unit_noise's column 0 is vision's draw
 
 
 # ------------------------------------------------------------------------------------------
