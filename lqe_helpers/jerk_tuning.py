@@ -114,15 +114,12 @@ def tune_jerk_std(scenario: Scenario, jerk_stds: Sequence[float] | np.ndarray,
                          f"{_short(grid)}")
     runs = scenario.mc_runs if runs is None else validation.count("runs", runs, minimum=2)
     sensors = model.sensor_names(sensors)
-    C = model.observation_matrix(sensors)
-    z0 = np.asarray(scenario.z0, dtype=float)
     noise = scenario.unit_noise(runs, sensors)  # one draw for every σ_j
     nis_mean, likelihood, mse = [], [], []
     for jerk_std in grid:
         variant = dataclasses.replace(scenario, jerk_std=float(jerk_std))
         tracking = experiments.track(variant, sensors, runs=runs, noise=noise)
-        innovations = metrics.innovations(tracking.measurements, tracking.result, variant.A,
-                                          C, z0)
+        innovations = tracking.innovations()
         nis_mean.append(metrics.nis_test(innovations, variant.burn_in_steps).mean)
         likelihood.append(metrics.innovation_log_likelihood(innovations,
                                                             variant.burn_in_steps))

@@ -260,7 +260,12 @@ def test_check_jerk_from_readings_names_each_realistic_mistake(mistake, phrase):
 
 
 def test_the_checks_recomputation_agrees_with_jerk_tuning():
-    """The check's own NIS, likelihood and MSE arrays equal jerk_tuning's on the same grid."""
+    """The check judges against jerk_tuning on the notebook's grid (700–2 800 cm/s³, 17 values).
+
+    The check calls jerk_tuning.tune_jerk_std on its choice_grid(); this fails if that grid
+    drifts from the notebook's. jerk_tuning itself is tested against metrics.nis_test and
+    the Gaussian log-likelihood in test_jerk_tuning.py.
+    """
     mine = background_jerk_choice._choice()["choice"]
     theirs = choice()
     np.testing.assert_allclose(mine.nis_mean, theirs.nis_mean, rtol=1e-10)

@@ -17,6 +17,7 @@ from pathlib import Path
 import nbformat
 import pytest
 from nbformat.v4 import new_code_cell, new_notebook
+from tools_helpers import snapshot
 
 from lqe_helpers.authoring import command_line, files, manifest, notebook_io, transaction
 from lqe_helpers.authoring.errors import (
@@ -29,20 +30,6 @@ from lqe_helpers.authoring.manifest import MANIFEST_NAME
 from lqe_helpers.authoring.output_folder import check_out_dir, write_output_folder
 
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
-
-
-def snapshot(folder: Path) -> dict[str, bytes | str]:
-    """Every file (its bytes), link (its target) and folder under ``folder``."""
-    found: dict[str, bytes | str] = {}
-    for path in sorted(folder.rglob("*")):
-        name = path.relative_to(folder).as_posix()
-        if path.is_symlink():
-            found[name] = f"link -> {os.readlink(path)}"
-        elif path.is_dir():
-            found[name] = "folder"
-        else:
-            found[name] = path.read_bytes()
-    return found
 
 
 def full_disk_after(limit: int):

@@ -28,7 +28,8 @@ every ``check_…`` and the tolerances:
   validating what a student passes;
 - ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
   mistakes of an MSE and of a paired difference;
-- ``numbers``: the number checks several notebooks share until they have their own.
+- ``shared_runs``: the engine's Monte Carlo runs that checks of several notebooks compare
+  with, made once per kernel.
 """
 
 from .background import (
@@ -107,7 +108,6 @@ from .noisier_proprioception_further import (
     check_proprioception_sweep,
     check_sweep_reading,
 )
-from .numbers import check_mse, check_paired_difference
 from .vision import check_filter, check_vision_difference, check_vision_mse
 from .vision_further import (
     check_nis,
@@ -160,7 +160,6 @@ __all__ = [
     "check_late_eye",
     "check_misjudged",
     "check_misjudged_nis",
-    "check_mse",
     "check_nis",
     "check_noise_free_fits",
     "check_noisier_difference",
@@ -170,7 +169,6 @@ __all__ = [
     "check_one_step_error",
     "check_overconfidence",
     "check_p0_sweep",
-    "check_paired_difference",
     "check_prediction_theory",
     "check_proprioception_sweep",
     "check_sampling_ratio",

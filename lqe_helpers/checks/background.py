@@ -31,12 +31,14 @@ from .machinery import (
     CheckFailed,
     call_student,
     close,
+    keyed_entries,
     passed,
     require_callable,
     student_result,
     time_limit_text,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -337,16 +339,10 @@ PERIODS = {"an eighth": 1 / 8, "a quarter": 1 / 4, "a half": 1 / 2, "a whole": 1
 
 def _named(values: object, name: str, what: str) -> dict[str, object]:
     """The student's dict with one entry per name of :data:`PERIODS`."""
-    if not isinstance(values, Mapping):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by the names of periods "
-                          f"({', '.join(repr(key) for key in PERIODS)}), got {found}")
-    missing = [key for key in PERIODS if key not in values]
-    if missing:
-        have = ", ".join(repr(key) for key in values) or "none"
-        raise CheckFailed(f"{name} has no entry {missing[0]!r} (its keys: {have}); use the "
-                          f"names of periods as keys")
-    return {key: values[key] for key in PERIODS}
+    return keyed_entries(
+        values, name, tuple(PERIODS), what,
+        keyed_by=f"the names of periods ({', '.join(repr(key) for key in PERIODS)})",
+        advice="; use the names of periods as keys")
 
 
 def _sigma_mistakes(fraction: float) -> dict[str, float]:
@@ -376,7 +372,7 @@ def _matching_runs() -> dict[str, dict[str, np.ndarray]]:
     """Per-run MSEs (runs,) of each matching time, with what the usual slips give."""
     truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
     noise = DEFAULT.unit_noise(DEFAULT.mc_runs, ("vision",))  # the task's draw, drawn once
-    default = experiments.track(DEFAULT, runs=DEFAULT.mc_runs, noise=noise)
+    default = vision_runs()  # the pack's σ_j on the same draw
     found = {}
     for key, fraction in PERIODS.items():
         sigma = matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency, dt, fraction)

@@ -26,10 +26,12 @@ from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
     CheckFailed,
-    argument_array,
+    keyed_entries,
     passed,
+    shaped_argument,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -43,30 +45,6 @@ SUB_STEPS = 1000
 
 def _sigma_j() -> float:
     return DEFAULT.process_jerk_std
-
-
-def shaped_argument(value: object, name: str, shape: tuple[int, ...], what: str) -> np.ndarray:
-    """The student's array of ``shape``, or CheckFailed naming it."""
-    return argument_array(value, name, f"{what}, an array of shape {shape}", shape=shape)
-
-
-def keyed_entries(values: object, name: str, keys: tuple, what: str) -> dict:
-    """The student's dict with an entry for each of ``keys`` (numbers compared as floats)."""
-    if not isinstance(values, Mapping):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by "
-                          f"{', '.join(repr(key) for key in keys)}, got {found}")
-    found_keys = {}
-    for key in values:
-        if isinstance(key, (int, float, np.number)) and not isinstance(key, bool):
-            found_keys[float(key)] = values[key]
-        else:
-            found_keys[key] = values[key]
-    missing = [key for key in keys if key not in found_keys]
-    if missing:
-        have = ", ".join(repr(key) for key in values) or "none"
-        raise CheckFailed(f"{name} has no entry {missing[0]!r} (its keys: {have})")
-    return {key: found_keys[key] for key in keys}
 
 
 # ------------------------------------------------------------------------------------------
@@ -243,7 +221,7 @@ def _white() -> dict[str, object]:
     """Task D's Q_white and the paired % interval, recomputed, with wrong variants."""
     sigma_j, dt, M = _sigma_j(), DEFAULT.dt, SUB_STEPS
     right = white_jerk_q(sigma_j, dt, M)
-    runs = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    runs = vision_runs()
     truth, burn = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
 
     def mse_with(Q: np.ndarray, whole: bool = False) -> np.ndarray:

@@ -15,12 +15,19 @@ from collections.abc import Mapping
 
 import numpy as np
 
-from .. import experiments, metrics
-from ..jerk_tuning import JerkChoice
+from .. import experiments, jerk_tuning, metrics
 from ..scenario import DEFAULT
-from .background_further import keyed_entries, shaped_argument
 from .judging import judge
-from .machinery import MATRIX_RTOL, MSE_RTOL, CheckFailed, passed, tolerance_text
+from .machinery import (
+    MATRIX_RTOL,
+    MSE_RTOL,
+    CheckFailed,
+    keyed_entries,
+    passed,
+    shaped_argument,
+    tolerance_text,
+)
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -194,13 +201,13 @@ CHOICE_KEYS = ("likelihood", "NIS", "MSE")
 def _choice() -> dict[str, object]:
     """Task E recomputed: the NIS at the derived σ_j (and wrong variants), and the choice.
 
-    The innovations, their NIS and log-likelihood are computed here for one sensor
-    directly (ν²/S and −½ (ν²/S + ln 2πS)), not through :mod:`lqe_helpers.jerk_tuning`,
-    whose refinement between grid points (:class:`~lqe_helpers.jerk_tuning.JerkChoice`)
-    is then applied to these arrays.
+    The NIS is ν²/S of the shared runs' innovations, as the task computes it; the choice
+    is the pack's :func:`lqe_helpers.jerk_tuning.tune_jerk_std` on the task's grid (the
+    engine the task names, tested against the NIS and the Gaussian log-likelihood in
+    ``tests/test_jerk_tuning.py``), not a second copy of its formulas.
     """
     burn = DEFAULT.burn_in_steps
-    tracking = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    tracking = vision_runs()
     innovations = tracking.innovations()
     nu, S = innovations.values[..., 0], innovations.covariances[..., 0, 0]
     R = DEFAULT.sigma_v**2
@@ -216,20 +223,7 @@ def _choice() -> dict[str, object]:
         "it is the mean squared innovation (cm²), not normalised by S":
             float(np.mean(nu[:, burn:] ** 2)),
     }}
-    grid = choice_grid()
-    noise = DEFAULT.unit_noise(DEFAULT.mc_runs, ("vision",))  # one draw for every σ_j
-    nis_mean, likelihood, mse = [], [], []
-    for value in grid:
-        variant = dataclasses.replace(DEFAULT, jerk_std=float(value))
-        run = experiments.track(variant, runs=DEFAULT.mc_runs, noise=noise)
-        inn = run.innovations()
-        nu, S = inn.values[:, burn:, 0], inn.covariances[:, burn:, 0, 0]
-        epsilon = nu**2 / S
-        nis_mean.append(float(epsilon.mean()))
-        likelihood.append(-0.5 * np.sum(epsilon + np.log(2 * np.pi * S), axis=-1))
-        mse.append(run.mse())
-    choice = JerkChoice(grid, np.array(nis_mean), np.stack(likelihood, axis=-1),
-                        np.stack(mse, axis=-1), 1)
+    choice = jerk_tuning.tune_jerk_std(DEFAULT, choice_grid())
     chosen = {"likelihood": choice.by_likelihood, "NIS": choice.by_nis, "MSE": choice.by_mse}
     return {"nis": nis, "chosen": chosen, "choice": choice}
 
@@ -241,8 +235,8 @@ def check_jerk_from_readings(nis_mean: object, chosen: Mapping[str, float]) -> N
     vision-only runs at the derived σ_j, ``nis_mean`` the mean of ν²/S after the burn-in
     (within :data:`MSE_RTOL` relative); then, on the grid :func:`choice_grid` and the
     same draws, the σ_j of the largest mean innovation log-likelihood, of the mean NIS
-    equal to 1 and of the smallest mean MSE, each refined between grid points as
-    :class:`~lqe_helpers.jerk_tuning.JerkChoice` does (within :data:`MSE_RTOL` relative).
+    equal to 1 and of the smallest mean MSE, each refined between grid points, from
+    :func:`lqe_helpers.jerk_tuning.tune_jerk_std` (within :data:`MSE_RTOL` relative).
 
     Parameters
     ----------

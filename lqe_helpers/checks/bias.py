@@ -26,6 +26,7 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -118,7 +119,7 @@ def _signal_worth() -> dict[str, object]:
     """Task 2's paired interval (cm²), recomputed, with the usual wrong ones."""
     truth = DEFAULT.truth[:, 0]
     with_signal = bias_model.track_with_input(DEFAULT, runs=DEFAULT.mc_runs)
-    vision = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
+    vision = vision_runs()
     first, second = with_signal.mse(), vision.mse()
     return {
         "right": metrics.mean_ci95(first - second),

@@ -21,9 +21,19 @@ import numpy as np
 
 from .. import bias_model, experiments, metrics
 from ..scenario import DEFAULT
-from .background_further import keyed_entries, shaped_argument
 from .judging import interval_mistakes, judge, judge_interval
-from .machinery import INTERVAL_RTOL, MATRIX_RTOL, MSE_RTOL, CheckFailed, passed, tolerance_text
+from .machinery import (
+    INTERVAL_RTOL,
+    MATRIX_RTOL,
+    MSE_RTOL,
+    CheckFailed,
+    interval_list,
+    keyed_entries,
+    passed,
+    shaped_argument,
+    tolerance_text,
+)
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -41,7 +51,7 @@ def _monte_carlo() -> bias_model.InputTracking:
 @functools.cache
 def _vision_only() -> np.ndarray:
     """Per-run MSEs (runs,) of the vision-only filter on the same camera noise (cm²)."""
-    return experiments.track(DEFAULT, runs=DEFAULT.mc_runs, noise=_noise()[..., :1]).mse()
+    return vision_runs().mse()  # bias_model.unit_noise's column 0 is vision's draw
 
 
 # ------------------------------------------------------------------------------------------
@@ -249,15 +259,6 @@ def _sweep() -> dict[str, object]:
     return found
 
 
-def _intervals(values: object, name: str, size: int) -> list:
-    if not isinstance(values, Sequence) or isinstance(values, str) or len(values) != size:
-        found = f"{len(values)} items" if isinstance(values, Sequence) else \
-            f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a list of {size} metrics.Interval, one per σ_a of "
-                          f"sigma_a_grid, got {found}")
-    return list(values)
-
-
 def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
                         sweep_paired: Sequence[metrics.Interval], sweep_rms: np.ndarray,
                         sweep_std: np.ndarray) -> None:
@@ -279,8 +280,8 @@ def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
     """
     right = _sweep()
     grid = sigma_a_grid()
-    mses = _intervals(sweep_mse, "sweep_mse", grid.size)
-    paired = _intervals(sweep_paired, "sweep_paired", grid.size)
+    mses = interval_list(sweep_mse, "sweep_mse", "σ_a of sigma_a_grid", grid.size)
+    paired = interval_list(sweep_paired, "sweep_paired", "σ_a of sigma_a_grid", grid.size)
     arrays = {name: shaped_argument(value, name, (grid.size,), "one value per σ_a (cm/s²)")
               for name, value in (("sweep_rms", sweep_rms), ("sweep_std", sweep_std))}
     for j, i in enumerate(SWEEP_CHECKED):

@@ -8,8 +8,9 @@
   over the Monte Carlo runs and the share of the delay's cost won back, recomputed with
   :mod:`lqe_helpers.experiments`.
 
-The Going further tasks are checked in :mod:`lqe_helpers.checks.delay_further`, which
-reuses the Monte Carlo runs kept here (:func:`monte_carlo_tracking`).
+Task 3's runs are :func:`lqe_helpers.checks.shared_runs.vision_runs`. The Going further
+tasks are checked in :mod:`lqe_helpers.checks.delay_sweep` and
+:mod:`lqe_helpers.checks.delay_further`.
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -330,17 +332,9 @@ def check_delay_signals(late_readings: np.ndarray, delayed: np.ndarray,
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
-def monte_carlo_tracking() -> experiments.Tracking:
-    """Task 3's ``DEFAULT.mc_runs`` vision-only runs (the engine), kept for the later checks."""
-    tracking = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
-    tracking.result.estimates.setflags(write=False)
-    return tracking
-
-
-@functools.cache
 def monte_carlo_mses() -> dict[str, np.ndarray]:
     """Per-run MSEs (runs,) (cm²) at the question's delay: delayed, compensated, undelayed."""
-    tracking = monte_carlo_tracking()
+    tracking = vision_runs()
     batch = experiments.delay_and_compensate(tracking, DEFAULT.delay)
     values = {"delayed": batch.mse("delayed"), "predicted": batch.mse("predicted"),
               "now": tracking.mse()}

@@ -4,7 +4,7 @@ Each recomputes what its task asks from the task's own inputs (Task 3's Monte Ca
 the filter's model) before looking at the student's values:
 
 - :func:`check_delay_sweep`: per-run MSEs of both estimates at every delay of the sweep,
-  on Task 3's runs (:func:`~lqe_helpers.checks.delay.monte_carlo_tracking`);
+  on Task 3's runs (:func:`~lqe_helpers.checks.shared_runs.vision_runs`);
 - :func:`check_prediction_theory`: the steady-state covariance of the estimate carried
   forward (Lesson 0.5 eq. (9)), and its two sources;
 - :func:`check_compensation_regimes`: the delays at which compensation helps;
@@ -24,9 +24,9 @@ from .. import experiments, metrics
 from ..prediction import predict_ahead, propagate_covariance
 from ..scenario import DEFAULT
 from ..simulation import delay_signal
-from .delay import monte_carlo_tracking
 from .judging import judge
 from .machinery import MATRIX_RTOL, MSE_RTOL, CheckFailed, argument_array, passed, tolerance_text
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -49,7 +49,7 @@ def sweep() -> dict[str, np.ndarray]:
     :func:`~lqe_helpers.prediction.predict_ahead`), so it takes well under a second;
     read-only.
     """
-    tracking = monte_carlo_tracking()
+    tracking = vision_runs()
     estimates = tracking.result.estimates
     rows: dict[str, list[np.ndarray]] = {"delayed": [], "predicted": []}
     for steps in range(SWEEP_STEPS + 1):

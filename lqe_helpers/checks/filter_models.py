@@ -20,9 +20,18 @@ from .machinery import SEED
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
 
+#: The parameters of ``my_filter(y, A, C, Q, R, z0, P0)``, in order (Tutorial eq. (5)).
+FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
+
+
 @dataclass(frozen=True)
-class FilterModel:
-    """A small random model for :func:`check_filter` (all arrays float, read-only)."""
+class FilterCase:
+    """One call of :func:`check_filter`: a small random model and its readings.
+
+    All arrays float and read-only. Not :class:`lqe_helpers.experiments.FilterModel`,
+    the model a filter of the butterfly assumes: this one is drawn at random and carries
+    its readings ``y``.
+    """
 
     y: np.ndarray
     A: np.ndarray
@@ -56,7 +65,7 @@ class FilterModel:
 
     def engine(self, **changed: np.ndarray):
         """The engine's result on this model, with the inputs in ``changed`` replaced."""
-        inputs = dict(zip(("y", "A", "C", "Q", "R", "z0", "P0"), self.args, strict=True))
+        inputs = dict(zip(FILTER_ARGS, self.args, strict=True))
         return kalman_filter(**{**inputs, **changed})
 
 
@@ -69,7 +78,7 @@ FILTER_STEPS = 15
 
 
 @functools.cache
-def models() -> tuple[FilterModel, ...]:
+def models() -> tuple[FilterCase, ...]:
     """The models of :func:`check_filter`, drawn once from :data:`SEED` (read-only)."""
     rng = np.random.default_rng(SEED)
     drawn = []
@@ -94,7 +103,7 @@ def models() -> tuple[FilterModel, ...]:
         arrays = [np.array(a, dtype=float) for a in (y, A, C, Q, R, z0, P0)]
         for array in arrays:
             array.setflags(write=False)
-        drawn.append(FilterModel(*arrays))
+        drawn.append(FilterCase(*arrays))
     return tuple(drawn)
 
 
@@ -111,7 +120,7 @@ def _matrix_sqrt(S: np.ndarray) -> np.ndarray:
     return vectors @ np.diag(np.sqrt(np.clip(values, 0.0, None))) @ vectors.T
 
 
-def _gains_of(m: FilterModel, gain: str, update: str) -> list[np.ndarray]:
+def _gains_of(m: FilterCase, gain: str, update: str) -> list[np.ndarray]:
     """Gains of a mistaken covariance recursion: K from R alone, or P updated without A."""
     P, gains = m.P0, []
     for _ in range(m.n):
@@ -125,7 +134,7 @@ def _gains_of(m: FilterModel, gain: str, update: str) -> list[np.ndarray]:
     return gains
 
 
-def _estimates_with(m: FilterModel, gains, start: str, compare: str) -> np.ndarray:
+def _estimates_with(m: FilterCase, gains, start: str, compare: str) -> np.ndarray:
     """Estimates from given gains; ẑ starts from A ẑ or ẑ, y is compared with C A ẑ or C ẑ."""
     z, rows = m.z0, []
     for y_j, K in zip(m.y, gains, strict=True):

@@ -31,6 +31,7 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
+from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -320,7 +321,7 @@ def monte_carlo_mses() -> dict[str, np.ndarray]:
     :mod:`~lqe_helpers.checks.fusion_further`.
     """
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
-    vision = experiments.track(DEFAULT, ("vision",), runs=runs)
+    vision = vision_runs()
     fused = experiments.track(DEFAULT, FUSED, runs=runs)
     values = {"vision": vision.positions, "fused": fused.positions,
               "raw": vision.measurement_mse("vision")}

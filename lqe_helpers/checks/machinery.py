@@ -3,14 +3,15 @@
 Every check runs a student's function through :func:`call_student` (the time limit and the
 one-line reports of :mod:`lqe_helpers.student_code`), reads what it returned with
 :func:`student_result`, and validates each value a student passes with
-:func:`argument_array` or :func:`positive_number`, so that a wrong type or shape is one
+:func:`argument_array`, :func:`positive_number`, :func:`shaped_argument` or
+:func:`keyed_entries` (a dict keyed as the task asks), so that a wrong type or shape is one
 :class:`CheckFailed` naming the argument. ``__tracebackhide__`` keeps these frames out of
 pytest's report; :class:`CheckFailed` keeps them out of Jupyter's.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Hashable, Mapping, Sequence
 
 import numpy as np
 
@@ -23,17 +24,20 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 #: verdict and message every time it runs).
 SEED = 2026
 
-#: Relative tolerance of the function checks (:func:`check_filter`,
-#: :func:`check_compensation`), scaled by the largest entry of the correct result.
+#: Relative tolerance of what a student's function or filter run returns (the estimates of
+#: ``check_filter``, ``check_compensation``, ``check_smoother``, a trial's positions),
+#: scaled by the largest entry of the correct result.
 FUNCTION_RTOL = 1e-9
 
 #: Relative tolerance of a mean squared error, of the expected value's size.
 MSE_RTOL = 1e-6
 
-#: Relative tolerance of :func:`check_initial_covariance` and :func:`check_fusion`.
+#: Relative tolerance of a matrix or array the student computes as the check does (C, R,
+#: P0, A, a steady-state variance, an RMS curve): it agrees to rounding.
 MATRIX_RTOL = 1e-9
 
-#: Tolerance (s) of the convergence-time checks of notebook 02: a time is a whole number of samples.
+#: Tolerance (s) of a time read off a curve (a convergence or crossing time): a whole
+#: number of samples, so exact to rounding.
 TIME_ATOL = 1e-9
 
 #: Relative tolerance (of the interval's scale: its mean or half-width, whichever is
@@ -168,6 +172,88 @@ def positive_number(value: object, name: str, unit: str) -> float:
     if number <= 0:
         raise CheckFailed(f"{name} must be {what}, got {number:g}")
     return number
+
+
+def shaped_argument(value: object, name: str, shape: tuple[int, ...], what: str) -> np.ndarray:
+    """The student's array ``name`` of ``shape`` (``what`` it holds), or CheckFailed naming it."""
+    return argument_array(value, name, f"{what}, an array of shape {shape}", shape=shape)
+
+
+def keyed_entries(values: object, name: str, keys: Sequence[Hashable], what: str, *,
+                  keyed_by: str | None = None, entry: Callable[[Hashable], str] = repr,
+                  advice: str = "") -> dict:
+    """The student's dict ``name`` with an entry for each of ``keys``, or CheckFailed.
+
+    A number as a key is compared as a float (``{10: …}`` serves the key 10.0, as does a
+    NumPy number); a bool is not a number and serves no key.
+
+    Parameters
+    ----------
+    values : object
+        What the student passed, e.g. ``mse_filtered``.
+    name : str
+        Its name, for messages.
+    keys : sequence
+        The keys the task asks for, in order (numbers as floats, or names).
+    what : str
+        What its values are ("MSEs (cm²) of the readings").
+    keyed_by : str, optional
+        What the keys are, for the message when ``values`` is not a dict ("σ_v (cm)");
+        default the keys themselves.
+    entry : callable
+        How a missing key is named ("'an eighth'", "for σ_v = 1.5 cm"); default its repr.
+    advice : str
+        Appended to the message of a missing key ("; use the names of periods as keys").
+
+    Returns
+    -------
+    dict
+        The student's value for each key of ``keys``, in their order.
+
+    Raises
+    ------
+    CheckFailed
+        If ``values`` is not a dict, or a key of ``keys`` is missing from it.
+    """
+    if not isinstance(values, Mapping):
+        found = "None" if values is None else f"a {type(values).__name__}"
+        if keyed_by is None:
+            keyed_by = ", ".join(repr(key) for key in keys)
+        raise CheckFailed(f"{name} must be a dict of {what} keyed by {keyed_by}, got {found}")
+    found_keys = {_as_key(key): value for key, value in values.items()
+                  if not isinstance(key, bool)}
+    missing = [key for key in keys if key not in found_keys]
+    if missing:
+        have = ", ".join(repr(key) for key in values) or "none"
+        raise CheckFailed(f"{name} has no entry {entry(missing[0])} (its keys: {have}){advice}")
+    return {key: found_keys[key] for key in keys}
+
+
+def _as_key(key: Hashable) -> Hashable:
+    """A student's dict key as :func:`keyed_entries` compares it: numbers as floats."""
+    return float(key) if isinstance(key, (int, float, np.integer, np.floating)) else key
+
+
+def interval_list(values: object, name: str, one_per: str, size: int | None = None) -> list:
+    """The student's list (or tuple) ``name`` of intervals, one per value of a grid.
+
+    ``one_per`` says what each is for ("σ_a of sigma_a_grid"); ``size`` is how many the
+    grid has (None: any number but 0). The items are judged later
+    (:func:`~lqe_helpers.checks.judging.judge_interval`).
+
+    Raises
+    ------
+    CheckFailed
+        If ``values`` is not a list or tuple of that length.
+    """
+    is_list = isinstance(values, (list, tuple))
+    if not is_list or len(values) != ((len(values) or 1) if size is None else size):
+        found = (f"{len(values)} entries" if is_list
+                 else "None" if values is None else f"a {type(values).__name__}")
+        count = "" if size is None else f"{size} "
+        raise CheckFailed(f"{name} must be a list of {count}metrics.Interval, one per "
+                          f"{one_per}, got {found}")
+    return list(values)
 
 
 # ------------------------------------------------------------------------------------------

@@ -19,14 +19,13 @@ import numpy as np
 from .. import experiments, metrics
 from ..scenario import DEFAULT
 from .judging import interval_mistakes, judge, judge_interval
-from .machinery import INTERVAL_RTOL, MSE_RTOL, passed, tolerance_text
+from .machinery import INTERVAL_RTOL, MSE_RTOL, interval_list, passed, tolerance_text
 from .noisier_proprioception import (
     BURN,
     FUSED,
     SIGMA_P,
     SIGMA_V,
     entries,
-    intervals,
     monte_carlo,
     paired,
     sigma_grid,
@@ -193,7 +192,8 @@ def check_assumed_sweep(assumed_grid: np.ndarray, excess_ci: list) -> None:
         over vision alone, the whole trial, unpaired, ...
     """
     grid = sigma_grid("assumed_grid", assumed_grid)
-    excesses = intervals("excess_ci", excess_ci, "assumed_grid", grid.size)
+    excesses = interval_list(excess_ci, "excess_ci", "value of assumed_grid in its order",
+                             grid.size)
     # The first, a quarter of the way, the last; never the true σ_p, whose excess is
     # zero up to round-off.
     true = np.isclose(grid, SIGMA_P, rtol=1e-9, atol=0)

@@ -33,6 +33,7 @@ from .machinery import (
     MSE_RTOL,
     CheckFailed,
     argument_array,
+    keyed_entries,
     passed,
     tolerance_text,
 )
@@ -77,16 +78,8 @@ def paired(first: np.ndarray, second: np.ndarray) -> metrics.Interval:
 
 def entries(name: str, values: object, keys: tuple[object, ...], what: str) -> dict:
     """The student's dict ``name``, which must hold ``keys``."""
-    if not isinstance(values, dict):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by {keys[0]!r}, … (the "
-                          f"task's keys), got {found}")
-    missing = [key for key in keys if key not in values]
-    if missing:
-        have = ", ".join(repr(key) for key in values) or "none"
-        raise CheckFailed(f"{name} has no entry {missing[0]!r} (its keys: {have}); the task "
-                          f"asks for {', '.join(repr(key) for key in keys)}")
-    return values
+    return keyed_entries(values, name, keys, what, keyed_by=f"{keys[0]!r}, … (the task's keys)",
+                         advice=f"; the task asks for {', '.join(repr(key) for key in keys)}")
 
 
 def sigma_grid(name: str, values: object) -> np.ndarray:
@@ -96,17 +89,6 @@ def sigma_grid(name: str, values: object) -> np.ndarray:
         raise CheckFailed(f"{name} must be a 1-D array of at least 3 increasing σ values > 0 "
                           f"(cm), got shape {grid.shape}")
     return grid
-
-
-def intervals(name: str, values: object, grid: str, size: int | None = None) -> list:
-    """The student's list of intervals, one per value of the grid ``grid`` (``size``)."""
-    if not isinstance(values, (list, tuple)) or len(values) != (size or len(values) or 1):
-        found = (f"{len(values)} entries" if isinstance(values, (list, tuple))
-                 else "None" if values is None else f"a {type(values).__name__}")
-        count = f"{size} " if size else ""
-        raise CheckFailed(f"{name} must be a list of {count}metrics.Interval, one per value "
-                          f"of {grid} in its order, got {found}")
-    return list(values)
 
 
 # ------------------------------------------------------------------------------------------

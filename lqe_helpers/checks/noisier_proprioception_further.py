@@ -23,6 +23,7 @@ from .machinery import (
     MATRIX_RTOL,
     MSE_RTOL,
     CheckFailed,
+    interval_list,
     passed,
     tolerance_text,
 )
@@ -33,7 +34,6 @@ from .noisier_proprioception import (
     SIGMA_P_C,
     SIGMA_V,
     entries,
-    intervals,
     monte_carlo,
     paired,
     sigma_grid,
@@ -145,7 +145,8 @@ def check_proprioception_sweep(sweep_sigma_p: np.ndarray, margin_by_sigma: list,
         fraction, the whole trial, σ in R, the prediction's P∞, ...
     """
     grid = sigma_grid("sweep_sigma_p", sweep_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p", grid.size)
+    margins = interval_list(margin_by_sigma, "margin_by_sigma",
+                            "value of sweep_sigma_p in its order", grid.size)
     marks = [np.flatnonzero(np.isclose(grid, mark, rtol=1e-9, atol=0)) for mark in (1.5, 4.5)]
     if not all(mark.size for mark in marks):
         raise CheckFailed("sweep_sigma_p must include 1.5 and 4.5 cm, the σ_p of questions (c) "
@@ -213,7 +214,8 @@ def check_sweep_reading(better: int, worse: int, benefit_below: dict,
         level, ...
     """
     dense = sigma_grid("dense_sigma_p", dense_sigma_p)
-    margins = intervals("margin_by_sigma", margin_by_sigma, "sweep_sigma_p")
+    margins = interval_list(margin_by_sigma, "margin_by_sigma",
+                            "value of sweep_sigma_p in its order")
     try:
         parts = np.array([[float(m.low), float(m.mean), float(m.high)] for m in margins])
     except (AttributeError, TypeError, ValueError):

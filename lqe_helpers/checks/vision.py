@@ -14,16 +14,17 @@
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 from collections.abc import Callable
 
 import numpy as np
 
-from .. import experiments, metrics, model, simulation
+from .. import experiments, metrics, simulation
 from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
-from .filter_models import FILTER_MISTAKES, FILTER_STEPS, FilterModel
+from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
     FUNCTION_RTOL,
@@ -33,6 +34,7 @@ from .machinery import (
     CheckFailed,
     call_student,
     close,
+    keyed_entries,
     match_mistake,
     passed,
     require_callable,
@@ -46,7 +48,6 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 #: The question's two noise levels of vision (cm).
 SIGMAS_V = (1.5, 4.5)
 
-_FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
 _FILTER_SHAPE_HINT = (
     "The shapes in one product or sum do not fit: write the shape beside each term (y_j is "
     "(m,), ẑ is (k,), C is (m, k), P and A are (k, k), R is (m, m), K is (k, m)).")
@@ -86,7 +87,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     for index, m in enumerate(models):
         try:
             output = call_student(my_filter, *m.args, name=name, where=m.describe(),
-                                  arg_names=_FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
+                                  arg_names=FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
                                   forbid=(kalman_filter,))
         except STOP_CALLING:
             raise
@@ -111,7 +112,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     _explain_wrong_rows(name, models[wrong[0]], answers[wrong[0]], correct[wrong[0]])
 
 
-def _explain_wrong_rows(name: str, m: FilterModel, answer: np.ndarray,
+def _explain_wrong_rows(name: str, m: FilterCase, answer: np.ndarray,
                         right: np.ndarray) -> None:
     """CheckFailed for a filter whose numbers differ in no typical way."""
     if answer.shape[0] > 1 and np.allclose(answer, answer[-1], rtol=0, atol=0) and \
@@ -137,7 +138,7 @@ def _explain_wrong_rows(name: str, m: FilterModel, answer: np.ndarray,
         f"{scale:.3g}.)")
 
 
-def _filter_output(output: object, name: str, m: FilterModel) -> np.ndarray:
+def _filter_output(output: object, name: str, m: FilterCase) -> np.ndarray:
     """The filter's output as an (n, k) array, or a CheckFailed naming what came back."""
     n, k = m.n, m.k
     what = f"the estimates ẑ, an array of shape (n, k) = {(n, k)}"
@@ -190,10 +191,14 @@ def _readings(sigma_v: float, scale: float | None = None) -> np.ndarray:
 
 
 def _filtered(readings: np.ndarray, r_variance: float) -> np.ndarray:
-    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]]."""
-    return kalman_filter(readings, DEFAULT.A, model.observation_matrix(("vision",)), DEFAULT.Q,
-                         np.array([[r_variance]]), np.asarray(DEFAULT.z0, dtype=float),
-                         DEFAULT.P0).estimates[:, 0]
+    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]].
+
+    The tasks' vision-only model (:func:`lqe_helpers.experiments.filter_model`) with its
+    R replaced, so that a slip in R (σ for σ², σ⁴) is filtered exactly as written.
+    """
+    vision = experiments.filter_model(DEFAULT)
+    return dataclasses.replace(vision, R=np.array([[r_variance]])).filter(
+        readings).estimates[:, 0]
 
 
 @functools.cache
@@ -260,22 +265,11 @@ def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS
     CheckFailed
         If ``values`` is not a dict, or a key due is missing.
     """
-    if not isinstance(values, dict):
-        found = "None" if values is None else f"a {type(values).__name__}"
-        raise CheckFailed(f"{name} must be a dict of {what} keyed by {key} ({unit}), e.g. "
-                          f"{name}[{keys[-1]:g}], got {found}")
-    found_keys = {}
-    for item in values:
-        if isinstance(item, (int, float, np.number)) and not isinstance(item, bool):
-            found_keys[float(item)] = values[item]
-    missing = [value for value in keys if value not in found_keys]
-    if missing:
-        have = ", ".join(repr(item) for item in values) or "none"
-        raise CheckFailed(f"{name} has no entry for {key} = {missing[0]:g} {unit} (its keys: "
-                          f"{have}); the task asks for {key} = "
-                          f"{', '.join(f'{value:g}' for value in keys)} {unit}, keyed by the "
-                          f"number {key} itself")
-    return found_keys
+    return keyed_entries(
+        values, name, keys, what, keyed_by=f"{key} ({unit}), e.g. {name}[{keys[-1]:g}]",
+        entry=lambda missing: f"for {key} = {missing:g} {unit}",
+        advice=f"; the task asks for {key} = {', '.join(f'{value:g}' for value in keys)} "
+               f"{unit}, keyed by the number {key} itself")
 
 
 def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float, float]) -> None:

@@ -307,38 +307,52 @@ def check_nis(nis_mean: dict[float, float], runs_inside: dict[float, float]) -> 
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
-def _sampling_runs(dt: float, jerk_std: float | None = None) -> experiments.Tracking:
+def _sampling_mses(dt: float, jerk_std: float | None = None) -> dict[str, np.ndarray]:
+    """Per-run MSEs (runs,) (cm²) of part 4's raw readings and estimates at Δt = ``dt``.
+
+    ``DEFAULT.mc_runs`` runs at σ_v = :data:`SAMPLING_SIGMA_V` of
+    ``dataclasses.replace(DEFAULT, dt=dt, jerk_std=jerk_std)`` (``jerk_std`` None: σ_j
+    matched to Δt), keyed ``raw`` and ``filtered`` after the scenario's burn-in, and
+    ``…_default`` after ``DEFAULT.burn_in_steps`` samples and ``…_whole`` over the whole
+    trial (two likely mistakes). Only these are kept, not the runs (up to 60 MB each).
+    """
     scenario = dataclasses.replace(DEFAULT, dt=dt, jerk_std=jerk_std)
-    return experiments.track(scenario, sigmas=[SAMPLING_SIGMA_V], runs=DEFAULT.mc_runs)
+    runs = experiments.track(scenario, sigmas=[SAMPLING_SIGMA_V], runs=DEFAULT.mc_runs)
+    truth = scenario.truth[:, 0]
+    found = {}
+    for suffix, burn in (("", scenario.burn_in_steps), ("_default", DEFAULT.burn_in_steps),
+                         ("_whole", 0)):
+        found[f"raw{suffix}"] = metrics.mse(runs.measurements[..., 0], truth, burn)
+        found[f"filtered{suffix}"] = metrics.mse(runs.positions, truth, burn)
+    for array in found.values():
+        array.setflags(write=False)
+    return found
 
 
-def _ratio(runs: experiments.Tracking, burn_in_steps: int | None = None) -> float:
-    truth = runs.scenario.truth[:, 0]
-    burn = runs.scenario.burn_in_steps if burn_in_steps is None else burn_in_steps
-    raw = metrics.mse(runs.measurements[..., 0], truth, burn)
-    filtered = metrics.mse(runs.positions, truth, burn)
-    return float(raw.mean() / filtered.mean())
+def _ratio(mses: dict[str, np.ndarray], suffix: str = "") -> float:
+    """Mean raw MSE / mean filtered MSE of :func:`_sampling_mses` (after the burn-in
+    ``suffix`` names)."""
+    return float(mses[f"raw{suffix}"].mean() / mses[f"filtered{suffix}"].mean())
 
 
 def _ratio_mistakes(dt: float) -> dict[str, float]:
-    runs = _sampling_runs(dt)
-    truth, burn = runs.scenario.truth[:, 0], runs.scenario.burn_in_steps
-    raw = metrics.mse(runs.measurements[..., 0], truth, burn)
-    filtered = metrics.mse(runs.positions, truth, burn)
+    mses = _sampling_mses(dt)
+    raw, filtered = mses["raw"], mses["filtered"]
+    burn = dataclasses.replace(DEFAULT, dt=dt).burn_in_steps
     return {
         "it is filtered / raw; the task asks for raw / filtered": float(
             filtered.mean() / raw.mean()),
         f"σ_j is held at {DEFAULT.process_jerk_std:,.0f} cm/s³ at every Δt, so the jerk "
         f"intensity σ_j² Δt changes with Δt; leave jerk_std unset (the scenario matches σ_j "
-        f"to Δt)": _ratio(_sampling_runs(dt, DEFAULT.process_jerk_std)),
+        f"to Δt)": _ratio(_sampling_mses(dt, DEFAULT.process_jerk_std)),
         f"it leaves out {DEFAULT.burn_in_steps} samples at every Δt; the burn-in is "
         f"{DEFAULT.burn_in:g} s, which is {burn} samples at Δt = {dt:g} s":
-            _ratio(runs, DEFAULT.burn_in_steps),
+            _ratio(mses, "_default"),
         "it is the mean of the per-run ratios; the task asks for the ratio of the mean MSEs":
             float(np.mean(raw / filtered)),
         "it is one run's ratio; use all DEFAULT.mc_runs runs": float(raw[0] / filtered[0]),
         "it is the ratio over the whole trial: leave out each scenario's burn-in":
-            _ratio(runs, 0),
+            _ratio(mses, "_whole"),
     }
 
 
@@ -365,7 +379,7 @@ def check_sampling_ratio(ratio: dict[float, float]) -> None:
     values = keyed(ratio, "ratio", "ratios raw / filtered", keys=SAMPLING_DTS, key="Δt",
                    unit="s")
     for dt in SAMPLING_DTS:
-        name, right = f"ratio[{dt:g}]", _ratio(_sampling_runs(dt))
+        name, right = f"ratio[{dt:g}]", _ratio(_sampling_mses(dt))
         try:
             judge(name, values[dt], right, MSE_RTOL)
         except CheckFailed:
