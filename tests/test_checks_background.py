@@ -146,17 +146,23 @@ def eyes_closed(*, mistake=""):
     P = tracking.result.estimate_covariances[close]
     if mistake == "from zero":
         P = np.zeros((3, 3))
-    sigma = DEFAULT.process_jerk_std**2 if mistake == "sigma squared" else \
-        DEFAULT.process_jerk_std
+    sigma = {"sigma squared": DEFAULT.process_jerk_std**2,
+             "sigma_v": DEFAULT.sigma_v}.get(mistake, DEFAULT.process_jerk_std)
     A, g = model.transition_matrix(DEFAULT.dt), model.jerk_input_matrix(DEFAULT.dt)
+    P_close = P
     variances = [P[0, 0]]
     for _ in range(100):
-        P = predict_covariance(P, A, g, sigma)
+        if mistake == "restart":  # each step from P_close, not from the last P
+            P = predict_covariance(P_close, A, g, sigma)
+        else:
+            P = predict_covariance(P, A, g, sigma)
         variances.append(P[0, 0])
     variances = np.array(variances)
     two_sigma = {"one sigma": np.sqrt(variances), "no root": 2 * variances,
                  "no start": 2 * np.sqrt(variances[1:])}.get(mistake, 2 * np.sqrt(variances))
-    above = np.argmax(2 * np.sqrt(variances) > DEFAULT.amplitude)
+    compared = {"variance crossing": variances,
+                "sigma crossing": np.sqrt(variances)}.get(mistake, 2 * np.sqrt(variances))
+    above = np.argmax(compared > DEFAULT.amplitude)
     crossing = {"samples": above, "last below": (above - 1) * DEFAULT.dt,
                 "trial time": 2.0 + above * DEFAULT.dt}.get(mistake, above * DEFAULT.dt)
     return two_sigma, crossing
@@ -173,9 +179,13 @@ def test_check_eyes_closed_passes_the_worked_solution(capsys):
     ("no start", "keep the moment the eyes close too"),
     ("from zero", "it starts from P = 0"),
     ("sigma squared", "σ_j² where its standard deviation σ_j belongs"),
+    ("sigma_v", "sigma is vision's noise σ_v"),
+    ("restart", "every step starts again from P_close"),
     ("samples", "it is in samples"),
     ("last below", "one step early"),
     ("trial time", "it counts from the start of the trial"),
+    ("variance crossing", "it is when the variance P[0, 0] (cm²) exceeds the amplitude"),
+    ("sigma crossing", "it is when σ exceeds the amplitude"),
 ])
 def test_check_eyes_closed_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_eyes_closed, predict_covariance,
@@ -189,71 +199,60 @@ def test_check_eyes_closed_checks_the_function_first():
                  two_sigma, crossing)
 
 
-# --- check_jerk_matching (Task 3) ------------------------------------------------------------
+# --- check_jerk_stds (Task 3) ----------------------------------------------------------------
 
 PERIODS = {"an eighth": 1 / 8, "a quarter": 1 / 4, "a half": 1 / 2, "a whole": 1.0}
 
 
-def jerk_matching(*, mistake=""):
-    """jerk_stds, mse_runs and whole_vs_quarter of Task 3 as a student writes them."""
-    import dataclasses
-
-    from lqe_helpers import experiments, metrics
+def jerk_stds(*, mistake=""):
+    """jerk_stds of Task 3 as a student writes it, with one slip at most."""
     from lqe_helpers.scenario import DEFAULT
 
-    f = DEFAULT.frequency
-    omega = f if mistake == "omega is f" else 2 * np.pi * f
-    jerk_stds, mse_runs, per_run = {}, {}, {}
+    f, dt, amplitude = DEFAULT.frequency, DEFAULT.dt, DEFAULT.amplitude
+    omega = {"omega is f": f, "omega 2 pi over f": 2 * np.pi / f}.get(mistake, 2 * np.pi * f)
+    found = {}
     for name, fraction in PERIODS.items():
-        T = fraction if mistake == "T in periods" else fraction / f
-        jerk_stds[name] = DEFAULT.amplitude * omega**2 / np.sqrt(DEFAULT.dt * T)
-        if mistake == "no sqrt":
-            jerk_stds[name] = DEFAULT.amplitude * omega**2 / (DEFAULT.dt * T)
-        variant = DEFAULT if mistake == "default scenario" else dataclasses.replace(
-            DEFAULT, jerk_std=jerk_stds[name])
-        batch = experiments.track(variant, runs=DEFAULT.mc_runs)
-        per_run[name] = {"whole trial": metrics.mse(batch.positions, DEFAULT.truth[:, 0])
-                         }.get(mistake, batch.mse())
-        # "mean only": the interval below still made from the runs (else it would not run)
-        mse_runs[name] = per_run[name].mean() if mistake == "mean only" else per_run[name]
-    whole, quarter = per_run["a whole"], per_run["a quarter"]
-    whole_vs_quarter = {
-        "reversed": lambda: metrics.mean_ci95(quarter - whole),
-        "percent": lambda: metrics.mean_ci95(100 * (whole - quarter) / quarter.mean()),
-        "unpaired": lambda: metrics.Interval(
-            whole.mean() - quarter.mean(),
-            whole.mean() - quarter.mean() - metrics.mean_ci95(whole).half_width
-            - metrics.mean_ci95(quarter).half_width,
-            whole.mean() - quarter.mean() + metrics.mean_ci95(whole).half_width
-            + metrics.mean_ci95(quarter).half_width, whole.size),
-    }.get(mistake, lambda: metrics.mean_ci95(whole - quarter))()
-    return jerk_stds, mse_runs, whole_vs_quarter
+        T = {"T in periods": fraction, "T times f": fraction * f}.get(mistake, fraction / f)
+        found[name] = {
+            "no sqrt": amplitude * omega**2 / (dt * T),
+            "root over dt only": amplitude * omega**2 / np.sqrt(dt) * T,
+            "root over dt, then divided by T": amplitude * omega**2 / np.sqrt(dt) / T,
+            "omega not squared": amplitude * omega / np.sqrt(dt * T),
+            "variance": (amplitude * omega**2 / np.sqrt(dt * T)) ** 2,
+            "times the root": amplitude * omega**2 * np.sqrt(dt * T),
+        }.get(mistake, amplitude * omega**2 / np.sqrt(dt * T))
+    return found
 
 
-def test_check_jerk_matching_passes_the_worked_solution(capsys):
-    line = assert_passes(capsys, checks.check_jerk_matching, *jerk_matching())
-    assert "300 runs" in line
+def test_check_jerk_stds_passes_the_worked_solution(capsys):
+    line = assert_passes(capsys, checks.check_jerk_stds, jerk_stds())
+    assert "1/8, 1/4, 1/2 and 1 period" in line
+
+
+def test_the_quarter_period_gives_the_scenarios_jerk_std():
+    from lqe_helpers.scenario import DEFAULT
+
+    assert np.isclose(jerk_stds()["a quarter"], DEFAULT.process_jerk_std, rtol=1e-12)
 
 
 @pytest.mark.parametrize(("mistake", "phrase"), [
     ("T in periods", "T is in periods, not seconds"),
+    ("T times f", "the period was taken as f"),
     ("omega is f", "ω is f (Hz)"),
+    ("omega 2 pi over f", "ω is 2π/f"),
     ("no sqrt", "the square root is missing"),
-    ("default scenario", "every run used the pack's σ_j"),
-    ("whole trial", "of the whole trial"),
-    ("mean only", "is one number"),
-    ("reversed", "the sign is reversed"),
-    ("percent", "it is in % of the quarter's MSE"),
-    ("unpaired", "combines the two separate intervals"),
+    ("root over dt, then divided by T", "the root covers Δt only"),
+    ("root over dt only", "it multiplies by T"),
+    ("omega not squared", "ω is not squared"),
+    ("variance", "it is σ_j², a variance"),
+    ("times the root", "it multiplies by √(Δt T)"),
 ])
-def test_check_jerk_matching_names_each_realistic_mistake(mistake, phrase):
-    assert_fails(phrase, checks.check_jerk_matching, *jerk_matching(mistake=mistake))
+def test_check_jerk_stds_names_each_realistic_mistake(mistake, phrase):
+    assert_fails(phrase, checks.check_jerk_stds, jerk_stds(mistake=mistake))
 
 
-def test_check_jerk_matching_wants_the_names_of_periods():
-    jerk_stds, mse_runs, interval = jerk_matching()
-    renamed = {f"T = {PERIODS[name]:g}": value for name, value in jerk_stds.items()}
-    assert_fails("has no entry 'an eighth'", checks.check_jerk_matching, renamed, mse_runs,
-                 interval)
-    assert_fails("must be a dict", checks.check_jerk_matching, list(jerk_stds.values()),
-                 mse_runs, interval)
+def test_check_jerk_stds_wants_the_names_of_periods():
+    values = jerk_stds()
+    renamed = {f"T = {PERIODS[name]:g}": value for name, value in values.items()}
+    assert_fails("has no entry 'an eighth'", checks.check_jerk_stds, renamed)
+    assert_fails("must be a dict", checks.check_jerk_stds, list(values.values()))

@@ -27,6 +27,15 @@ def bias_matrices(*, mistake=""):
     Q = sigma**2 * G @ G.T
     if mistake == "Q identity":
         Q = SIGMA_A**2 * np.eye(3)
+    if mistake == "Gt G":
+        Q = sigma**2 * G.T @ G
+    if mistake == "F transposed":
+        F = F.T
+    if mistake == "Q diagonal":
+        Q = np.diag(np.diag(sigma**2 * G @ G.T))
+    if mistake == "jerk Q":
+        from lqe_helpers.scenario import DEFAULT
+        Q = DEFAULT.Q
     return F, G, Q
 
 
@@ -40,6 +49,10 @@ def test_check_bias_model_passes_the_worked_solution(capsys):
     ("G flat", "make it a column"),
     ("sigma", "uses σ_a where its square belongs"),
     ("Q identity", "is not pushed through G"),
+    ("Gt G", "Q has shape (1, 1), one number: it is built as Gᵀ G"),
+    ("F transposed", "F is transposed"),
+    ("jerk Q", "Q is notebook 00's jerk noise"),
+    ("Q diagonal", "Q holds only the diagonal"),
 ])
 def test_check_bias_model_names_each_typical_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_bias_model, *bias_matrices(mistake=mistake), DT, SIGMA_A)
@@ -58,7 +71,8 @@ def test_check_bias_model_names_a_bad_argument():
 # --- check_signal_worth (Task 2) ------------------------------------------------------------
 
 def signal_worth(*, mistake=""):
-    """with_vs_without of Task 2, as a student writes it, with one slip at most."""
+    """improvement of Task 2 (vision only − with the signal), as a student writes it, with
+    one slip at most."""
     from lqe_helpers import experiments, metrics
     from lqe_helpers.scenario import DEFAULT
 
@@ -66,30 +80,49 @@ def signal_worth(*, mistake=""):
     vision_only = experiments.track(DEFAULT, runs=DEFAULT.mc_runs)
     with_signal = mc.dead_reckoning_mse() if mistake == "dead reckoning" else mc.mse()
     alone = vision_only.mse()
-    if mistake == "reversed":
-        return metrics.mean_ci95(alone - with_signal)
+    if mistake == "reversed":  # the old convention: with − without
+        return metrics.mean_ci95(with_signal - alone)
     if mistake == "percent":
-        return metrics.mean_ci95(100 * (with_signal - alone) / alone.mean())
+        return metrics.mean_ci95(100 * (alone - with_signal) / alone.mean())
     if mistake == "whole trial":
         truth = DEFAULT.truth[:, 0]
-        return metrics.mean_ci95(metrics.mse(mc.positions, truth)
-                                 - metrics.mse(vision_only.positions, truth))
+        return metrics.mean_ci95(metrics.mse(vision_only.positions, truth)
+                                 - metrics.mse(mc.positions, truth))
     if mistake == "one vision run":
-        return metrics.mean_ci95(with_signal - float(experiments.track(DEFAULT).mse()))
-    return metrics.mean_ci95(with_signal - alone)
+        return metrics.mean_ci95(float(experiments.track(DEFAULT).mse()) - with_signal)
+    if mistake == "percent reversed":
+        return metrics.mean_ci95(100 * (with_signal - alone) / alone.mean())
+    if mistake == "per-run relative":
+        return metrics.mean_ci95((alone - with_signal) / alone)
+    if mistake == "ratio":
+        return metrics.mean_ci95(alone / with_signal)
+    if mistake == "mean vision":
+        return metrics.mean_ci95(alone.mean() - with_signal)
+    if mistake == "mean signal":
+        return metrics.mean_ci95(alone - with_signal.mean())
+    return metrics.mean_ci95(alone - with_signal)
 
 
 def test_check_signal_worth_passes_the_worked_solution(capsys):
     line = assert_passes(capsys, checks.check_signal_worth, signal_worth())
-    assert "300 runs" in line
+    assert "300 runs" in line and "vision only − with the signal" in line
+
+
+def test_the_signal_helps_so_the_improvement_is_positive():
+    assert signal_worth().low > 0
 
 
 @pytest.mark.parametrize(("mistake", "phrase"), [
-    ("reversed", "the sign is reversed"),
+    ("reversed", "the sign is reversed: it is the MSE with the signal − the vision-only MSE"),
     ("percent", "it is in % of the vision-only MSE"),
     ("whole trial", "of the whole trial"),
     ("dead reckoning", "dead reckoning's MSE"),
     ("one vision run", "a single run"),
+    ("percent reversed", "in % of the vision-only MSE and the wrong way round"),
+    ("per-run relative", "divided by that run's vision-only MSE"),
+    ("ratio", "it is a ratio of the MSEs"),
+    ("mean vision", "one side is the mean MSE over the runs"),
+    ("mean signal", "the other the mean MSE over the runs"),
 ])
 def test_check_signal_worth_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_signal_worth, signal_worth(mistake=mistake))

@@ -118,7 +118,8 @@ def sigma_a_sweep(mistake=""):
         batch = bias_model.track_with_input(DEFAULT, bias=B_TRUE, sigma_a=value,
                                             runs=DEFAULT.mc_runs)
         sweep_mse.append(metrics.mean_ci95(batch.mse()))
-        difference = alone - batch.mse() if mistake == "reversed" else batch.mse() - alone
+        # vision only − with the signal (positive: the signal helps); reversed: the other way
+        difference = batch.mse() - alone if mistake == "reversed" else alone - batch.mse()
         sweep_paired.append(metrics.mean_ci95(difference))
         error = batch.bias_estimates[:, -1] - B_TRUE
         sweep_rms.append(np.mean(error**2) if mistake == "no root" else np.sqrt(np.mean(error**2)))
@@ -135,7 +136,7 @@ def test_check_sigma_a_sweep_passes_the_worked_solution(capsys):
 
 
 @pytest.mark.parametrize(("mistake", "phrase"), [
-    ("reversed", "the sign is reversed"),
+    ("reversed", "the sign is reversed: it is the MSE with the signal − the vision-only MSE"),
     ("no root", "the RMS is its square root"),
     ("variance", "it is the variance of b̂"),
     ("swapped", "it is the filter's own σ of b̂, not the RMS error"),
@@ -164,14 +165,15 @@ def bias_and_vision(mistake=""):
         scale = 100 / (reference if mistake == "own MSE" else reference.mean())
         change_by_bias[b] = metrics.mean_ci95(
             (batch.mse() - reference) if mistake == "cm²" else scale * (batch.mse() - reference))
-    change_by_sigma_v = {}
+    gain_by_sigma_v = {}
     for s in (0.5, 1.5, 4.5):
         with_signal = bias_model.track_with_input(DEFAULT, sigma_v=s, runs=DEFAULT.mc_runs).mse()
         alone = vision_only().mse() if mistake == "default sigma_v" else experiments.track(
             DEFAULT, sigmas=[s], runs=DEFAULT.mc_runs).mse()
         base = with_signal if mistake == "wrong base" else alone
-        change_by_sigma_v[s] = 100 * np.mean(with_signal - alone) / base.mean()
-    return change_by_bias, change_by_sigma_v
+        gain = alone - with_signal if mistake != "reversed" else with_signal - alone
+        gain_by_sigma_v[s] = 100 * np.mean(gain) / base.mean()
+    return change_by_bias, gain_by_sigma_v
 
 
 def test_check_bias_and_vision_passes_the_worked_solution(capsys):
@@ -183,6 +185,7 @@ def test_check_bias_and_vision_passes_the_worked_solution(capsys):
     ("cm²", "it is in cm²"),
     ("default sigma_v", "compare with vision alone at the same σ_v"),
     ("wrong base", "in % of the MSE with the signal"),
+    ("reversed", "the sign is reversed: with the signal − vision only"),
 ])
 def test_check_bias_and_vision_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_bias_and_vision, *bias_and_vision(mistake))

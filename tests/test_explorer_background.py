@@ -80,7 +80,8 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
                                expected.positions[shown], rtol=0, atol=1e-12)
     # The numbers go to the line beside the figure; the panels' titles never change.
     numbers = explorer.numbers
-    assert numbers.startswith(f"σ_j = {background.format_jerk(jerk_std)} cm/s³. ")
+    assert numbers.startswith(f"The pack's vision-only filter (yours comes in notebook 01), "
+                              f"σ_j = {background.format_jerk(jerk_std)} cm/s³. ")
     skip = DEFAULT.burn_in_steps
     mse = np.mean((expected.positions - truth)[skip:] ** 2)
     expects = np.mean(expected.position_variances[skip:])
@@ -165,7 +166,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert bundle["text/plain"].startswith("Interactive explorer")
     assert "σ_j (cm/s³)" in bundle["text/html"]
     assert explorer.png.startswith(b"\x89PNG")
-    assert explorer.numbers.startswith("σ_j = 1,000 cm/s³. ")
+    assert explorer.numbers.startswith(f"{background.WHOSE_FILTER} σ_j = 1,000 cm/s³. ")
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
@@ -189,7 +190,7 @@ def test_foreign_or_cleared_figure_is_rebuilt() -> None:
     figure.clear()
     numbers = background.draw_background(figure, jerk_std=2000.0)
     growth_ax, track_ax = figure.axes
-    assert numbers.startswith("σ_j = 2,000 cm/s³. ")
+    assert numbers.startswith(f"{background.WHOSE_FILTER} σ_j = 2,000 cm/s³. ")
     assert growth_ax.get_title() == background.GROWTH_TITLE
     assert len(growth_ax.get_lines()) == 3
     assert len(track_ax.get_lines()) == 3

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import html
 import math
 
 import numpy as np
@@ -32,6 +33,13 @@ def direct_filter(bias: float, sigma_a: float, sigma_v: float, noise: np.ndarray
                          np.array([[sigma_v**2]]), np.zeros(3), P0, B=G, u=readings[:, None])
 
 
+def direct_vision_only(sigma_v: float, noise: np.ndarray):
+    """Notebook 01's vision-only filter (the jerk model of notebook 00) on vision's noise."""
+    y = DEFAULT.truth[:, :1] + sigma_v * noise[:, :1]
+    return kalman_filter(y, DEFAULT.A, model.observation_matrix(("vision",)), DEFAULT.Q,
+                         np.array([[sigma_v**2]]), DEFAULT.z0, DEFAULT.P0)
+
+
 def direct_dead_reckoning(bias: float, sigma_a: float, noise: np.ndarray) -> np.ndarray:
     """Positions (cm) of the signal integrated step by step from the true start, b̂ = 0."""
     dt = DEFAULT.dt
@@ -51,12 +59,18 @@ def check_numbers(numbers: str, values: dict[str, float], noise: np.ndarray) -> 
     expected = direct_filter(bias, values["sigma_a"], values["sigma_v"], noise)
     truth = DEFAULT.truth[:, 0]
     end = f"{DEFAULT.duration:g} s"
+    assert numbers.startswith("The pack's filter with the signal as input (bias_model). ")
     assert f"b = {bias:g} cm/s²" in numbers
     final, std = expected.estimates[-1, 2], np.sqrt(expected.estimate_covariances[-1, 2, 2])
-    assert f"estimate at {end}: {final:.1f} ± {2 * std:.1f} cm/s²" in numbers
+    # ± 2σ to two significant figures, b̂ to as many decimals.
+    decimals = 1 - math.floor(math.log10(2 * std))
+    assert f"estimate at {end}: {final:.{decimals}f} ± {2 * std:.{decimals}f} cm/s²" in numbers
     skip = DEFAULT.burn_in_steps
     mse = np.mean((expected.estimates[skip:, 0] - truth[skip:]) ** 2)
-    assert f"after {DEFAULT.burn_in:g} s: {mse:.3g} cm²" in numbers
+    alone = direct_vision_only(values["sigma_v"], noise)
+    alone_mse = np.mean((alone.estimates[skip:, 0] - truth[skip:]) ** 2)
+    assert (f"after {DEFAULT.burn_in:g} s: {mse:.3g} cm² (vision-only filter on the same "
+            f"camera noise: {alone_mse:.3g} cm²)") in numbers
     off = direct_dead_reckoning(bias, values["sigma_a"], noise)[-1] - truth[-1]
     assert f"dead reckoning ends {off:+.0f} cm off the path at {end}" in numbers
 
@@ -139,7 +153,7 @@ def test_the_numbers_go_beside_the_figure_and_its_text_stays_put(explorer) -> No
         assert explorer.numbers != numbers, name
         numbers = explorer.numbers
     check_numbers(explorer.numbers, explorer.values, bias_model.unit_noise(EXPLORER_SCENARIO))
-    assert explorer.numbers in explorer._repr_mimebundle_()["text/html"]
+    assert html.escape(explorer.numbers) in explorer._repr_mimebundle_()["text/html"]
 
 
 def test_a_move_recomputes_only_what_its_slider_changes(explorer) -> None:
@@ -295,3 +309,28 @@ def test_scenario_outside_the_slider_range_is_refused(sigma_v: float) -> None:
     scenario = dataclasses.replace(DEFAULT, sigma_v=sigma_v)
     with pytest.raises(ValueError, match=rf"scenario\.sigma_v .*\[0\.5, 6\] cm, got {sigma_v:g}"):
         bias_explorer.explore_bias(scenario)
+
+
+def test_the_vision_only_run_hangs_on_sigma_v_only(explorer) -> None:
+    kept = explorer.draw.keywords["vision_mses"]
+    assert kept.computed == 1
+    for name, value, runs in [("bias", -30.0, 0), ("sigma_a", 40.0, 0), ("sigma_v", 3.0, 1)]:
+        before = kept.computed
+        explorer.sliders[name].value = value
+        assert kept.computed - before == runs, (name, value)
+
+
+@pytest.mark.parametrize("sigma_a", [1.0, 1000.0])
+def test_the_numbers_keep_their_precision_at_both_ends_of_sigma_a(explorer, sigma_a) -> None:
+    """At σ_a = 1 cm/s² b̂ is known to a few hundredths: no "± 0.0" (the trial's complaint)."""
+    explorer.sliders["sigma_a"].value = sigma_a
+    spread = explorer.numbers.split(" ± ")[1].split(" cm/s²")[0]
+    assert float(spread) > 0 and len(spread.replace(".", "").lstrip("0")) == 2, explorer.numbers
+    check_numbers(explorer.numbers, explorer.values, bias_model.unit_noise(EXPLORER_SCENARIO))
+
+
+def test_plus_minus_gives_two_significant_figures() -> None:
+    assert bias_explorer._plus_minus(19.934, 0.3141) == "19.93 ± 0.31"
+    assert bias_explorer._plus_minus(20.0123, 0.03141) == "20.012 ± 0.031"
+    assert bias_explorer._plus_minus(21.4, 13.2) == "21 ± 13"
+    assert bias_explorer._plus_minus(-3.0, 0.0) == "-3.00 ± 0.00"

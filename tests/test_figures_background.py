@@ -43,3 +43,25 @@ def test_jerk_choice_figure_refuses_curves_off_the_grid_and_unknown_choices():
         figures.jerk_choice_figure(grid, np.zeros(2), np.zeros(3), np.zeros(3), {})
     with pytest.raises(ValueError, match="chosen must be keyed by"):
         figures.jerk_choice_figure(grid, np.zeros(3), np.zeros(3), np.zeros(3), {"AIC": 2.0})
+
+
+@pytest.mark.parametrize("rows", [2, 4, 6])
+def test_mse_intervals_figure_keeps_its_legend_off_every_interval(rows):
+    """The trial found the legend beside the whole period's point (lower right): it now
+    sits below the axis label, clear of the axes and of the label."""
+    from lqe_helpers import metrics
+
+    values = np.linspace(0.38, 0.47, rows)[::-1]
+    intervals = [metrics.Interval(v, v - 0.003, v + 0.003, 300) for v in values]
+    fig = figures.mse_intervals_figure([f"row {i}" for i in range(rows)], intervals,
+                                       xlabel="MSE (cm²)", reference=0.4, reference_label="ref")
+    try:
+        fig.canvas.draw()
+        renderer = fig.canvas.get_renderer()
+        ax = fig.axes[0]
+        legend = ax.get_legend().get_window_extent(renderer)
+        assert legend.y1 < ax.get_window_extent(renderer).y0
+        assert legend.y1 < ax.xaxis.label.get_window_extent(renderer).y0
+        assert legend.y0 >= 0, "the legend stays inside the figure"
+    finally:
+        plt.close(fig)

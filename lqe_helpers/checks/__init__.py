@@ -35,7 +35,7 @@ every ``check_…`` and the tolerances:
 from .background import (
     check_covariance_step,
     check_eyes_closed,
-    check_jerk_matching,
+    check_jerk_stds,
     check_transition_matrix,
 )
 from .background_further import (
@@ -154,7 +154,7 @@ __all__ = [
     "check_initial_covariance",
     "check_initial_covariances",
     "check_jerk_from_readings",
-    "check_jerk_matching",
+    "check_jerk_stds",
     "check_jerk_sweep",
     "check_jerk_sweep_reading",
     "check_late_eye",

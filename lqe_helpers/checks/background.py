@@ -4,31 +4,28 @@
 - :func:`check_eyes_closed` (Task 2): the student's covariance step of Lesson 0.5 eq. (9),
   then the 2σ band it grows from the filter's covariance at t = 2 s and when it first
   exceeds the flight's amplitude, recomputed with the engine;
-- :func:`check_jerk_matching` (Task 3): σ_j matched over four time scales, the Monte Carlo
-  MSE of each and the paired whole − quarter difference, recomputed with the engine.
+- :func:`check_jerk_stds` (Task 3): σ_j matched over four time scales.
 
 The Going further tasks are checked in :mod:`lqe_helpers.checks.background_further`.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import functools
 from collections.abc import Callable, Mapping
 
 import numpy as np
 
-from .. import experiments, metrics, model
+from .. import experiments, model
 from ..prediction import propagate_covariance
 from ..scenario import DEFAULT, matched_jerk_std
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .judging import judge
 from .machinery import (
-    INTERVAL_RTOL,
     MATRIX_RTOL,
-    MSE_RTOL,
     SEED,
     TIME_ATOL,
     CheckFailed,
+    argument_array,
     call_student,
     close,
     keyed_entries,
@@ -38,7 +35,6 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
-from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -244,6 +240,8 @@ def _eyes_closed() -> dict[str, object]:
         return propagate_covariance(start, DEFAULT.A, Q, EYES_CLOSED_STEPS)[:, 0, 0]
 
     right = variance(P_close, sigma_j**2)
+    # Every step taken from P_close again instead of from the last P: one step, repeated.
+    restarted = np.concatenate([right[:1], np.full(EYES_CLOSED_STEPS, right[1])])
     bands = {
         "it is σ, not 2σ: double the standard deviation": np.sqrt(right),
         "it is twice the variance: take the square root of P[0, 0] (the standard deviation, "
@@ -259,11 +257,22 @@ def _eyes_closed() -> dict[str, object]:
         "it starts from the filter's prediction covariance at t = 2 s (before the reading "
         "of that sample); start from P_close, the covariance of its estimate":
             2 * np.sqrt(variance(result.covariances[close_at], sigma_j**2)),
+        "every step starts again from P_close, so the band stops growing after one step: "
+        "feed each step the P the step before returned": 2 * np.sqrt(restarted),
+        "sigma is vision's noise σ_v; the random input here is the jerk, of standard "
+        "deviation σ_j (sigma_j)": 2 * np.sqrt(variance(P_close, DEFAULT.sigma_v**2)),
     }
     two_sigma = 2 * np.sqrt(right)
     above = int(np.argmax(two_sigma > DEFAULT.amplitude))
+    # The first time another quantity than 2σ passes the amplitude (s after the eyes close).
+    other_crossings = {
+        "it is when the variance P[0, 0] (cm²) exceeds the amplitude; compare 2σ, "
+        "2 √P[0, 0] in cm, with it": int(np.argmax(right > DEFAULT.amplitude)) * DEFAULT.dt,
+        "it is when σ exceeds the amplitude; the task asks when 2σ does":
+            int(np.argmax(np.sqrt(right) > DEFAULT.amplitude)) * DEFAULT.dt,
+    }
     return {"two_sigma": two_sigma, "bands": bands, "crossing": above * DEFAULT.dt,
-            "steps": above}
+            "steps": above, "other_crossings": other_crossings}
 
 
 def check_eyes_closed(predict_covariance: Callable[..., np.ndarray], two_sigma: object,
@@ -293,8 +302,9 @@ def check_eyes_closed(predict_covariance: Callable[..., np.ndarray], two_sigma: 
     ------
     CheckFailed
         With the likely cause: the function's mistake, σ instead of 2σ, the variance,
-        σ_j² given as sigma, the band started from P = 0, 100 values instead of 101,
-        the crossing in samples, a step early, counted from the start of the trial, ...
+        σ_j² or σ_v given as sigma, every step from P_close, the band started from P = 0,
+        100 values instead of 101; the crossing in samples, a step early, counted from the
+        start of the trial, of the variance or of σ instead of 2σ, ...
     """
     name = _judge_covariance_step(predict_covariance, "check_eyes_closed")
     right = _eyes_closed()
@@ -322,6 +332,7 @@ def check_eyes_closed(predict_covariance: Callable[..., np.ndarray], two_sigma: 
                   (steps + 1) * dt,
               f"it counts from the start of the trial; count from the moment the eyes close "
               f"(t = {EYES_CLOSE_TIME:g} s)": steps * dt + EYES_CLOSE_TIME,
+              **right["other_crossings"],
           })
     passed(f"{name} follows eq. (9) on {len(_COVARIANCE_CASES)} random cases, and two_sigma "
            f"and crossing match the band grown from P_close by the pack's engine (to "
@@ -364,94 +375,53 @@ def _sigma_mistakes(fraction: float) -> dict[str, float]:
             a * omega**2 / (dt * T),
         "Δt is missing under the root: the random walk's spread after T is σ_j √(Δt T)":
             a * omega**2 / np.sqrt(T),
+        "the root covers Δt only (√Δt · T); it covers the product, √(Δt T)":
+            a * omega**2 / (np.sqrt(dt) * T),
+        "it multiplies by T; T belongs under the root, in the denominator: A ω² / √(Δt T)":
+            a * omega**2 / np.sqrt(dt) * T,
+        "it is σ_j², a variance (cm²/s⁶); jerk_stds holds the standard deviation σ_j":
+            (a * omega**2 / np.sqrt(dt * T)) ** 2,
+        "it multiplies by √(Δt T); divide by it: σ_j = A ω² / √(Δt T)":
+            a * omega**2 * np.sqrt(dt * T),
+        "ω is 2π/f; the angular frequency is ω = 2πf (rad/s)":
+            a * (2 * np.pi / f) ** 2 / np.sqrt(dt * T),
     }
 
 
-@functools.cache
-def _matching_runs() -> dict[str, dict[str, np.ndarray]]:
-    """Per-run MSEs (runs,) of each matching time, with what the usual slips give."""
-    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
-    noise = DEFAULT.unit_noise(DEFAULT.mc_runs, ("vision",))  # the task's draw, drawn once
-    default = vision_runs()  # the pack's σ_j on the same draw
-    found = {}
-    for key, fraction in PERIODS.items():
-        sigma = matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency, dt, fraction)
-        batch = experiments.track(dataclasses.replace(DEFAULT, jerk_std=sigma),
-                                  runs=DEFAULT.mc_runs, noise=noise)
-        found[key] = {"sigma": sigma, "mse": batch.mse(),
-                      "whole": metrics.mse(batch.positions, truth),
-                      "mistakes": {
-                          "every run used the pack's σ_j: make a Scenario with this σ_j "
-                          "(dataclasses.replace(DEFAULT, jerk_std=…)) for the filter":
-                              default.mse(),
-                          "it is the MSE of the raw readings, not of the filtered "
-                          "estimate": batch.measurement_mse("vision"),
-                          **mse_mistakes(batch.positions, truth, burn, dt)}}
-    return found
+def check_jerk_stds(jerk_stds: Mapping[str, float]) -> None:
+    """Check Task 3: σ_j = A ω² / √(Δt T) for the four matching times of :data:`PERIODS`.
 
-
-def check_jerk_matching(jerk_stds: Mapping[str, float], mse_runs: Mapping[str, np.ndarray],
-                        whole_vs_quarter: metrics.Interval) -> None:
-    """Check Task 3: σ_j for four matching times, their Monte Carlo MSEs, whole − quarter.
-
-    Recomputed from the task's inputs before looking at the student's: σ_j = A ω² /
-    √(Δt T) for T = 1/8, 1/4, 1/2 and 1 period (:func:`lqe_helpers.scenario.matched_jerk_std`,
-    within :data:`MATRIX_RTOL` relative), the per-run MSEs after the burn-in of
-    ``DEFAULT.mc_runs`` runs of the vision-only filter with each (the pack's engine,
-    :func:`lqe_helpers.experiments.track`, within :data:`MSE_RTOL` relative), and
-    ``metrics.mean_ci95`` of the per-run differences whole − quarter (within
-    :data:`INTERVAL_RTOL` of the interval's scale).
+    Recomputed from the task's inputs (:func:`lqe_helpers.scenario.matched_jerk_std` for
+    T = 1/8, 1/4, 1/2 and 1 period of the flight, in s), each within :data:`MATRIX_RTOL`
+    relative. The Monte Carlo runs with these values are the notebook's given cell.
 
     Parameters
     ----------
     jerk_stds : dict of str to float
         σ_j (cm/s³) keyed "an eighth", "a quarter", "a half", "a whole".
-    mse_runs : dict of str to ndarray, shape (runs,)
-        Per-run MSEs (cm²), same keys.
-    whole_vs_quarter : metrics.Interval
-        Paired mean of MSE(whole) − MSE(quarter) with its 95 % interval (cm²).
 
     Raises
     ------
     CheckFailed
-        Naming the entry and the likely cause: T in periods instead of seconds, ω = f,
-        ω not squared, no square root; the pack's σ_j for every T, the whole trial, one
-        MSE instead of the per-run values; the difference the wrong way round, unpaired,
-        in %, ...
+        Naming the entry and the likely cause: T in periods instead of seconds, the
+        period taken as f, ω = f or 2π/f, ω not squared or cubed, no square root, the
+        root over Δt only, Δt left out, ...
     """
     sigmas = _named(jerk_stds, "jerk_stds", "σ_j values (cm/s³)")
-    mses = _named(mse_runs, "mse_runs", "per-run MSEs (cm², shape (runs,))")
-    runs = _matching_runs()
-    for key, fraction in PERIODS.items():
-        judge(f"jerk_stds[{key!r}]", sigmas[key], runs[key]["sigma"], MATRIX_RTOL,
-              unit="cm/s³", what="A ω² / √(Δt T) recomputed for this T",
-              mistakes=_sigma_mistakes(fraction))
-    for key in PERIODS:
-        value = mses[key]
-        if np.ndim(value) == 0:
-            raise CheckFailed(
-                f"mse_runs[{key!r}] is one number; keep the per-run MSEs (.mse() of the "
-                f"{DEFAULT.mc_runs} runs, shape ({DEFAULT.mc_runs},)), so that the runs can "
-                f"be paired")
-        mistakes = dict(runs[key]["mistakes"])
-        if key == "a quarter":  # the pack's σ_j is the quarter's: not a mistake here
-            mistakes = {cause: v for cause, v in mistakes.items() if "pack's σ_j" not in cause}
-        judge(f"mse_runs[{key!r}]", value, runs[key]["mse"], MSE_RTOL, unit="cm²",
-              what="the per-run MSEs recomputed with the engine", mistakes=mistakes)
-    whole, quarter = runs["a whole"]["mse"], runs["a quarter"]["mse"]
-    percent = 100 / quarter.mean()
-    judge_interval(
-        "whole_vs_quarter", whole_vs_quarter, metrics.mean_ci95(whole - quarter),
-        INTERVAL_RTOL, unit="cm²",
-        what="the paired difference whole − quarter recomputed from the task's inputs",
-        mistakes={
-            **interval_mistakes(whole, quarter, "the whole period's MSE", "the quarter's MSE"),
-            "it is in % of the quarter's MSE; the task asks for the difference in cm²":
-                metrics.mean_ci95(percent * (whole - quarter)),
-            "the MSEs are those of the whole trial: leave out the burn-in in both":
-                metrics.mean_ci95(runs["a whole"]["whole"] - runs["a quarter"]["whole"]),
-        })
-    passed(f"σ_j for T = 1/8, 1/4, 1/2 and 1 period (to {tolerance_text(MATRIX_RTOL)}), the "
-           f"per-run MSEs of {DEFAULT.mc_runs} runs with each (to {tolerance_text(MSE_RTOL)}) "
-           f"and the paired whole − quarter interval (to {tolerance_text(INTERVAL_RTOL)}) "
-           f"match the pack's engine on the scenario's draws")
+    values = {key: argument_array(sigmas[key], f"jerk_stds[{key!r}]", "one number (cm/s³)",
+                                  shape=()) for key in PERIODS}
+    right = {key: matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency, DEFAULT.dt, fraction)
+             for key, fraction in PERIODS.items()}
+    mistakes = {key: _sigma_mistakes(fraction) for key, fraction in PERIODS.items()}
+    wrong = [key for key in PERIODS if not close(values[key], right[key], MATRIX_RTOL)]
+    # A slip made in the loop shows in every entry: name the one that explains them all
+    # (one entry alone can fit two slips, e.g. the eighth's √(Δt T f) = √Δt T).
+    for cause in mistakes[wrong[0]] if wrong else ():
+        if all(close(values[key], mistakes[key][cause], MATRIX_RTOL) for key in wrong):
+            raise CheckFailed(f"jerk_stds[{wrong[0]!r}] = {float(values[wrong[0]]):.6g} cm/s³ "
+                              f"is not right: {cause}")
+    for key in wrong:
+        judge(f"jerk_stds[{key!r}]", values[key], right[key], MATRIX_RTOL, unit="cm/s³",
+              what="A ω² / √(Δt T) recomputed for this T", mistakes=mistakes[key])
+    passed(f"σ_j = A ω² / √(Δt T) for T = 1/8, 1/4, 1/2 and 1 period of the flight, to "
+           f"{tolerance_text(MATRIX_RTOL)} relative")

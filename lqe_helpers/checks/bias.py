@@ -1,8 +1,9 @@
 """Checks of notebook 06, the bonus: the core tasks.
 
 - :func:`check_bias_model` (Task 1): F, G and Q of the biased acceleration model;
-- :func:`check_signal_worth` (Task 2): the paired MSE difference with − without the
-  signal, recomputed with :mod:`lqe_helpers.bias_model` and the engine.
+- :func:`check_signal_worth` (Task 2): the paired MSE difference vision only − with the
+  signal (positive: the signal helps), recomputed with :mod:`lqe_helpers.bias_model` and
+  the engine.
 
 The Going further tasks are checked in :mod:`lqe_helpers.checks.bias_further`.
 """
@@ -73,6 +74,11 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
         raise CheckFailed(f"G must have shape (3, 1): one row per state, one column for the "
                           f"single input; got shape {G.shape}")
     if not close(F, right_F, MATRIX_RTOL):
+        if close(F, right_F.T, MATRIX_RTOL):
+            raise CheckFailed(
+                "F is transposed: the state [p, v, b] is a column, so row 0 says how the new "
+                "position is made from p, v and b; the entries above the diagonal belong in "
+                "the first rows")
         if close(F[:, :2], right_F[:, :2], MATRIX_RTOL) and close(F[:2, 2], -right_F[:2, 2],
                                                                   MATRIX_RTOL):
             raise CheckFailed(
@@ -96,8 +102,13 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
         raise CheckFailed("G is not Lesson 0.5 eq. (5)'s input matrix: the reading enters the "
                           "position with Δt²/2, the velocity with Δt, the bias not at all")
     right_Q = sigma_a**2 * right_G @ right_G.T
+    if Q.shape == (1, 1):
+        raise CheckFailed(
+            "Q has shape (1, 1), one number: it is built as Gᵀ G. G is a column (3, 1), so "
+            "the covariance G σ_a² Gᵀ puts G first and its transpose last, 3 × 3")
     if Q.shape != (3, 3):
-        raise CheckFailed(f"Q must be 3 × 3, got shape {Q.shape}")
+        raise CheckFailed(f"Q must be 3 × 3 (G σ_a² Gᵀ with G of shape (3, 1)), got shape "
+                          f"{Q.shape}")
     if not close(Q, right_Q, MATRIX_RTOL):
         if close(Q, sigma_a * right_G @ right_G.T, MATRIX_RTOL):
             raise CheckFailed("Q uses σ_a where its square belongs: Q = G σ_a² Gᵀ (variances, "
@@ -106,9 +117,13 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
                 Q, sigma_a**2 * np.diag(right_G[:, 0]), MATRIX_RTOL):
             raise CheckFailed("Q is not pushed through G: the signal's noise reaches the "
                               "state the way the signal does, Q = G σ_a² Gᵀ")
-        if close(Q, sigma_a**2 * right_G.T @ right_G, MATRIX_RTOL):
-            raise CheckFailed("Q is built as Gᵀ G (one number); the covariance is G σ_a² Gᵀ, "
-                              "3 × 3")
+        if close(Q, np.diag(np.diag(right_Q)), MATRIX_RTOL):
+            raise CheckFailed("Q holds only the diagonal of G σ_a² Gᵀ; one noisy reading moves "
+                              "p and v together, so the off-diagonal entries belong too")
+        if close(Q, DEFAULT.Q, MATRIX_RTOL):
+            raise CheckFailed("Q is notebook 00's jerk noise (DEFAULT.Q, for the state [p, v, "
+                              "a]); here the noise is the signal's, reaching the state "
+                              "through G: G σ_a² Gᵀ")
         raise CheckFailed("Q is not G σ_a² Gᵀ (Lesson 0.5 eq. (9)) for the given σ_a")
     passed(f"F, G and Q = G σ_a² Gᵀ match Lesson 0.5 eqs. (5), (9) for Δt = {dt:g} s and "
            f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")
@@ -116,32 +131,48 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
 
 @functools.cache
 def _signal_worth() -> dict[str, object]:
-    """Task 2's paired interval (cm²), recomputed, with the usual wrong ones."""
+    """Task 2's paired interval vision only − with the signal (cm²), with the usual wrong ones."""
     truth = DEFAULT.truth[:, 0]
     with_signal = bias_model.track_with_input(DEFAULT, runs=DEFAULT.mc_runs)
     vision = vision_runs()
-    first, second = with_signal.mse(), vision.mse()
+    alone, helped = vision.mse(), with_signal.mse()
     return {
-        "right": metrics.mean_ci95(first - second),
+        "right": metrics.mean_ci95(alone - helped),
         "mistakes": {
-            **interval_mistakes(first, second, "the MSE with the signal",
-                                "the vision-only MSE"),
+            **interval_mistakes(alone, helped, "the vision-only MSE",
+                                "the MSE with the signal"),
             "it is in % of the vision-only MSE; the task asks for the difference in cm²":
-                metrics.mean_ci95(100 * (first - second) / second.mean()),
+                metrics.mean_ci95(100 * (alone - helped) / alone.mean()),
+            "it is in % of the vision-only MSE and the wrong way round; the task asks for "
+            "the difference vision only − with the signal, in cm²":
+                metrics.mean_ci95(100 * (helped - alone) / alone.mean()),
+            "it is a fraction of the vision-only MSE; the task asks for the difference in cm²":
+                metrics.mean_ci95((alone - helped) / alone.mean()),
+            "each run's difference is divided by that run's vision-only MSE; the task asks "
+            "for the difference itself, in cm²": metrics.mean_ci95((alone - helped) / alone),
+            "it is a ratio of the MSEs; the task asks for their difference, in cm²":
+                metrics.mean_ci95(alone / helped),
             "the MSEs are those of the whole trial: leave out the burn-in in both":
-                metrics.mean_ci95(metrics.mse(with_signal.positions, truth)
-                                  - metrics.mse(vision.positions, truth)),
+                metrics.mean_ci95(metrics.mse(vision.positions, truth)
+                                  - metrics.mse(with_signal.positions, truth)),
             "it uses dead reckoning's MSE (the signal integrated without vision), not the "
-            "filter's (mc.mse())": metrics.mean_ci95(with_signal.dead_reckoning_mse() - second),
+            "filter's (mc.mse())": metrics.mean_ci95(alone - with_signal.dead_reckoning_mse()),
             f"the vision-only runs are a single run, not {DEFAULT.mc_runs} runs paired with "
-            f"the signal's": metrics.mean_ci95(first - float(experiments.track(DEFAULT).mse())),
+            f"the signal's": metrics.mean_ci95(float(experiments.track(DEFAULT).mse()) - helped),
+            "one side is the mean MSE over the runs, the other the per-run MSEs; pair the "
+            "per-run MSEs run by run (vision_only.mse() − mc.mse())":
+                metrics.mean_ci95(alone.mean() - helped),
+            "one side is the per-run MSEs, the other the mean MSE over the runs; pair the "
+            "per-run MSEs run by run (vision_only.mse() − mc.mse())":
+                metrics.mean_ci95(alone - helped.mean()),
         },
     }
 
 
-def check_signal_worth(with_vs_without: metrics.Interval) -> None:
-    """Check Task 2: the paired MSE difference with the signal − vision only (cm²).
+def check_signal_worth(improvement: metrics.Interval) -> None:
+    """Check Task 2: the paired MSE difference vision only − with the signal (cm²).
 
+    Positive means the signal helps, as in notebooks 01, 03–05 (baseline − improved).
     Recomputed from the task's inputs before looking at the student's: the
     ``DEFAULT.mc_runs`` runs of :func:`lqe_helpers.bias_model.track_with_input` at the
     default bias and σ_a, and as many runs of the vision-only filter
@@ -149,17 +180,23 @@ def check_signal_worth(with_vs_without: metrics.Interval) -> None:
     of the per-run MSE differences after the burn-in, within :data:`INTERVAL_RTOL` of the
     interval's scale.
 
+    Parameters
+    ----------
+    improvement : metrics.Interval
+        Mean of MSE(vision only) − MSE(with the signal) over the runs, with its 95 %
+        interval (cm²).
+
     Raises
     ------
     CheckFailed
         With the likely cause: the difference the wrong way round, unpaired, in %, over
-        the whole trial, dead reckoning's MSE for the filter's, ...
+        the whole trial, dead reckoning's MSE for the filter's, one vision-only run, ...
     """
     right = _signal_worth()
-    judge_interval("with_vs_without", with_vs_without, right["right"], INTERVAL_RTOL,
-                   unit="cm²", what="the paired difference with − without the signal, "
+    judge_interval("improvement", improvement, right["right"], INTERVAL_RTOL,
+                   unit="cm²", what="the paired difference vision only − with the signal, "
                                     "recomputed from the task's inputs",
                    mistakes=right["mistakes"])
-    passed(f"with − without the signal, paired over {DEFAULT.mc_runs} runs: mean and 95 % "
+    passed(f"vision only − with the signal, paired over {DEFAULT.mc_runs} runs: mean and 95 % "
            f"interval match the pack's engine on the task's draws to "
            f"{tolerance_text(INTERVAL_RTOL)} relative")

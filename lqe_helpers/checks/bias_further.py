@@ -237,7 +237,7 @@ def _sweep() -> dict[str, object]:
         error = batch.bias_estimates[:, -1] - BIAS
         std = batch.bias_stds[0, -1]
         found["mse"].append(metrics.mean_ci95(mse))
-        found["paired"].append(metrics.mean_ci95(mse - vision))
+        found["paired"].append(metrics.mean_ci95(vision - mse))
         found["rms"].append(float(np.sqrt(np.mean(error**2))))
         found["std"].append(float(std))
         found["mse_mistakes"].append({
@@ -245,8 +245,8 @@ def _sweep() -> dict[str, object]:
                 metrics.mse(batch.positions, truth)),
             "it is dead reckoning's MSE, not the filter's": metrics.mean_ci95(
                 batch.dead_reckoning_mse())})
-        found["paired_mistakes"].append(interval_mistakes(mse, vision, "the MSE with the signal",
-                                                          "the vision-only MSE"))
+        found["paired_mistakes"].append(interval_mistakes(vision, mse, "the vision-only MSE",
+                                                          "the MSE with the signal"))
         found["rms_mistakes"].append({
             "it is the mean squared error of b̂; the RMS is its square root":
                 float(np.mean(error**2)),
@@ -267,9 +267,9 @@ def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
     Recomputed at every third σ_a, both ends included (:data:`SWEEP_CHECKED`), with
     :func:`lqe_helpers.bias_model.track_with_input` (``DEFAULT.mc_runs`` runs, the default
     bias) and the vision-only runs: the MSE interval, the
-    paired interval with − without the signal (each within :data:`INTERVAL_RTOL` of the
-    interval's scale), the RMS error of b̂ at 10 s over the runs and the filter's σ of b̂
-    at 10 s (within :data:`MATRIX_RTOL` relative, cm/s²).
+    paired interval vision only − with the signal (positive: the signal helps; each within
+    :data:`INTERVAL_RTOL` of the interval's scale), the RMS error of b̂ at 10 s over the
+    runs and the filter's σ of b̂ at 10 s (within :data:`MATRIX_RTOL` relative, cm/s²).
 
     Raises
     ------
@@ -290,7 +290,8 @@ def check_sigma_a_sweep(sweep_mse: Sequence[metrics.Interval],
                        unit="cm²", what="the MSE with the signal, recomputed",
                        mistakes=right["mse_mistakes"][j])
         judge_interval(f"sweep_paired{where}", paired[i], right["paired"][j], INTERVAL_RTOL,
-                       unit="cm²", what="the paired difference with − without, recomputed",
+                       unit="cm²", what="the paired difference vision only − with the signal, "
+                            "recomputed",
                        mistakes=right["paired_mistakes"][j])
         for name, key in (("sweep_rms", "rms"), ("sweep_std", "std")):
             judge(f"{name}{where}", arrays[name][i], right[key][j], MATRIX_RTOL,
@@ -332,31 +333,31 @@ def _bias_and_vision() -> dict[str, dict]:
                                                   noise=_noise()).mse()
         alone = experiments.track(DEFAULT, sigmas=[s], runs=DEFAULT.mc_runs,
                                   noise=_noise()[..., :1]).mse()
-        change = 100 * np.mean(with_signal - alone) / alone.mean()
-        by_sigma[s] = float(change)
+        gain = 100 * np.mean(alone - with_signal) / alone.mean()
+        by_sigma[s] = float(gain)
         sigma_mistakes[s] = {
             f"the vision-only MSE is that of σ_v = {DEFAULT.sigma_v:g} cm for every σ_v; "
             f"compare with vision alone at the same σ_v":
-                float(100 * np.mean(with_signal - default_alone) / default_alone.mean()),
+                float(100 * np.mean(default_alone - with_signal) / default_alone.mean()),
             "it is in % of the MSE with the signal; the task asks for % of the vision-only "
-            "MSE": float(100 * np.mean(with_signal - alone) / with_signal.mean()),
-            "it is a fraction; the task asks for a percentage": float(change / 100),
-            "the sign is reversed: vision only − with the signal; the task asks for with − "
-            "vision only": float(-change)}
+            "MSE": float(100 * np.mean(alone - with_signal) / with_signal.mean()),
+            "it is a fraction; the task asks for a percentage": float(gain / 100),
+            "the sign is reversed: with the signal − vision only; the task asks for vision "
+            "only − with the signal (positive when the signal helps)": float(-gain)}
     return {"bias": by_bias, "bias_mistakes": bias_mistakes, "sigma": by_sigma,
             "sigma_mistakes": sigma_mistakes}
 
 
 def check_bias_and_vision(change_by_bias: Mapping[float, metrics.Interval],
-                          change_by_sigma_v: Mapping[float, float]) -> None:
+                          gain_by_sigma_v: Mapping[float, float]) -> None:
     """Check Task C's effect of the bias's size and of vision's noise.
 
     Recomputed with :func:`lqe_helpers.bias_model.track_with_input` on the task's draws:
     for b = −60, 0 and 60 cm/s², the paired MSE change against the default bias in % of
     its mean MSE, with its 95 % interval (within :data:`INTERVAL_RTOL` of the interval's
-    scale); for σ_v = 0.5, 1.5 and 4.5 cm, the mean paired change with − without the
-    signal in % of the vision-only MSE at the same σ_v (within :data:`MATRIX_RTOL`
-    relative).
+    scale); for σ_v = 0.5, 1.5 and 4.5 cm, the mean paired gain vision only − with the
+    signal in % of the vision-only MSE at the same σ_v (positive: the signal helps; within
+    :data:`MATRIX_RTOL` relative).
 
     Raises
     ------
@@ -372,12 +373,14 @@ def check_bias_and_vision(change_by_bias: Mapping[float, metrics.Interval],
         judge_interval(f"change_by_bias[{b:g}]", biases[b], right["bias"][b], INTERVAL_RTOL,
                        unit="%", what="the paired change against the default bias, recomputed",
                        mistakes=right["bias_mistakes"][b])
-    sigmas = keyed_entries(change_by_sigma_v, "change_by_sigma_v", SIGMAS_V,
-                           "changes in % (one number each)")
+    sigmas = keyed_entries(gain_by_sigma_v, "gain_by_sigma_v", SIGMAS_V,
+                           "gains in % (one number each)")
     for s in SIGMAS_V:
-        judge(f"change_by_sigma_v[{s:g}]", sigmas[s], right["sigma"][s], MATRIX_RTOL,
-              unit="%", what="the change with − without the signal at this σ_v, recomputed",
+        judge(f"gain_by_sigma_v[{s:g}]", sigmas[s], right["sigma"][s], MATRIX_RTOL,
+              unit="%", what="the gain vision only − with the signal at this σ_v, "
+                             "recomputed",
               mistakes=right["sigma_mistakes"][s])
-    passed(f"the changes by bias (intervals, to {tolerance_text(INTERVAL_RTOL)}) and by σ_v "
+    passed(f"the changes by bias (intervals, to {tolerance_text(INTERVAL_RTOL)}) and the gains "
+           f"by σ_v "
            f"(to {tolerance_text(MATRIX_RTOL)} relative) match the pack's bias model and the "
            f"vision-only filter on the task's draws")

@@ -3,9 +3,10 @@
 Left panel: how fast the position uncertainty grows once the measurements stop
 (Lesson 0.5 eq. (9) with no correction). Right panel: one tracking run at the same
 σ_j, to see the trade-off between lag (σ_j too small) and noise (σ_j too large).
-The numbers of the view (σ_j, when the uncertainty reaches the flight's amplitude,
-this run's MSE and the variance the filter expects) are returned as one line of
-text that the explorer shows between the slider and the figure.
+The numbers of the view (whose filter runs: the pack's; σ_j, when the uncertainty
+reaches the flight's amplitude, this run's MSE and the variance the filter expects)
+are returned as one line of text that the explorer shows between the slider and the
+figure.
 
 Speed: building the axes, ticks and legends costs more than the filter run, so
 :func:`draw_background` builds the panels once per figure and afterwards only
@@ -44,6 +45,9 @@ JERK_STD_RANGE = (10.0, 1.0e5)
 #: the amplitude, the answer of a task in notebook 00 (issue 15); the scenario's σ_j
 #: stays in the left panel as the reference curve.
 START_JERK_STD = 1000.0
+
+#: How the numbers line starts: whose filter runs (the student writes theirs in notebook 01).
+WHOSE_FILTER = "The pack's vision-only filter (yours comes in notebook 01),"
 
 #: Titles of the two panels; they never change (the numbers go beside the figure).
 GROWTH_TITLE = "Uncertainty once the measurements stop"
@@ -161,7 +165,8 @@ def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEF
     Returns
     -------
     str
-        The numbers of this view, for the line beside the figure: σ_j, when 2σ of
+        The numbers of this view, for the line beside the figure: whose filter runs
+        (:data:`WHOSE_FILTER`), σ_j, when 2σ of
         the predicted position first reaches the amplitude, and this run's position
         MSE after the burn-in (cm²) with the error variance the filter expects there.
 
@@ -190,9 +195,10 @@ def _draw(figure: Figure, *, jerk_std: float, scenario: Scenario,
     panels.growth.set_ydata(2 * growth.position_stds)
     panels.vision.set_ydata(tracking.measurements[window, 0])
     panels.estimate.set_ydata(tracking.positions[window])
-    return (f"σ_j = {format_jerk(jerk_std)} cm/s³. Without measurements, 2σ of the predicted "
-            f"position reaches the flight's amplitude of {scenario.amplitude:g} cm "
-            f"{_crossing_text(growth, scenario.amplitude)}. Tracking MSE of this run after "
+    return (f"{WHOSE_FILTER} σ_j = {format_jerk(jerk_std)} cm/s³. Without measurements, 2σ "
+            f"of the predicted position reaches the flight's amplitude of "
+            f"{scenario.amplitude:g} cm {_crossing_text(growth, scenario.amplitude)}. "
+            f"Tracking MSE of this run after "
             f"{scenario.burn_in:g} s: {float(tracking.mse()):.3g} cm², the filter expects "
             f"{expected:.3g} cm².")
 

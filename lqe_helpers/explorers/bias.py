@@ -3,11 +3,11 @@
 Three sliders: the signal's true bias b, its noise σ_a and vision's noise σ_v.
 Left panel: the filter's bias estimate converging to the true bias, with the ±2σ
 band of its own covariance. Right panel: the hand's path, vision, the filtered
-position and dead reckoning (the signal integrated without vision), which drifts
-away quadratically. The numbers of the view (b, the bias estimate at the end of the
-trial, the filtered MSE and how far dead reckoning ends off the path) are not drawn
-in the figure: the drawing function returns them as one line of text, which the
-explorer shows between the sliders and the picture.
+position and dead reckoning (the signal integrated without vision). The numbers of the
+view (whose filter runs: the pack's; b, the bias estimate at the end of the trial, the
+filtered MSE beside the vision-only filter's on the same camera noise, and how far dead
+reckoning ends off the path) are not drawn in the figure: the drawing function returns
+them as one line of text, which the explorer shows between the sliders and the picture.
 
 Speed: building the axes, ticks and legends costs more than the filter run, so
 :func:`draw_bias` builds the panels once per figure and afterwards only replaces the
@@ -16,12 +16,13 @@ filter run depends on σ_a and σ_v alone, since the filter is linear in its inp
 a move of b only shifts the estimates by b times the filter's response to a unit
 input (:func:`~lqe_helpers.bias_model.unbiased_run`, the same path notebook 06's
 :func:`~lqe_helpers.bias_model.track_with_input` takes). The explorer keeps the run
-of the last (σ_a, σ_v) only (:class:`~lqe_helpers.explorers.cache.LastResults`):
-going back to a σ pays for its filter run again.
+of the last (σ_a, σ_v) only (:class:`~lqe_helpers.explorers.cache.LastResults`), and the
+vision-only filter's MSE of the last σ_v: going back to a σ pays for its filter run again.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -33,7 +34,7 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
-from .. import bias_model
+from .. import bias_model, experiments
 from ..plotting import COLORS, label_time_position, style
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -138,10 +139,9 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
     filtered position and the dead-reckoned position. Only the first :data:`WINDOW`
     seconds are drawn. Returns the numbers of this view as one line of text (the
     explorer shows it beside the figure): b, the estimate b̂ ± 2σ at the end of the
-    trial, this run's filtered MSE after the burn-in and how far dead reckoning is
-    from the path at the end of the trial, e.g. "True bias b = 20 cm/s²; its estimate
-    at 10 s: 19.9 ± 1.3 cm/s². MSE of the filtered position after 1 s: 0.121 cm²;
-    dead reckoning ends +1012 cm off the path at 10 s."
+    trial, this run's filtered MSE after the burn-in beside the vision-only filter's on
+    the same camera noise, and how far dead reckoning is from the path at the end of the
+    trial (:func:`_bias_numbers`).
 
     A figure not drawn by this function is cleared first; on one it drew before,
     for the same scenario, the same artists receive the new data (rebuilding the
@@ -166,8 +166,9 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
     Returns
     -------
     str
-        b (cm/s²), b̂ ± 2σ (cm/s²) at the end of the trial, the filtered MSE (cm²)
-        after the burn-in and dead reckoning's position error (cm) at the end.
+        Whose filter runs (the pack's), b (cm/s²), b̂ ± 2σ (cm/s²) at the end of the
+        trial, the filtered MSE (cm²) after the burn-in with the vision-only filter's,
+        and dead reckoning's position error (cm) at the end.
 
     Raises
     ------
@@ -175,17 +176,37 @@ def draw_bias(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
         If a value is out of range, or ``noise`` has the wrong shape.
     """
     run = bias_model.unbiased_run(scenario, sigma_a, sigma_v, noise=noise)
-    return _draw_tracking(figure, run.at_bias(bias))
+    return _draw_tracking(figure, run.at_bias(bias),
+                          _vision_only_mse(scenario, run.sigma_v, noise=noise))
+
+
+def _vision_only_mse(scenario: Scenario, sigma_v: float, noise: np.ndarray | None = None
+                    ) -> float:
+    """MSE (cm²) after the burn-in of the vision-only filter of notebook 01 at ``sigma_v``.
+
+    Run by the pack's engine (:func:`lqe_helpers.experiments.track`) on the camera noise of
+    ``noise`` (its first column, shape (n, 2)), the noise the filter with the signal sees:
+    the comparison of notebook 06's Task 2, for one run. Default noise:
+    :func:`~lqe_helpers.bias_model.unit_noise`.
+    """
+    if noise is None:
+        noise = bias_model.unit_noise(scenario)
+    tracking = experiments.track(scenario, sigmas=[sigma_v], noise=np.asarray(noise)[..., :1])
+    return float(tracking.mse())
 
 
 def _draw(figure: Figure, *, bias: float, sigma_a: float, sigma_v: float,
-          unbiased_runs: Callable[[float, float], bias_model.UnbiasedRun]) -> str:
+          unbiased_runs: Callable[[float, float], bias_model.UnbiasedRun],
+          vision_mses: Callable[[float], float]) -> str:
     """:func:`draw_bias` for the explorer: ``unbiased_runs(σ_a, σ_v)`` makes or keeps the filter
-    run at b = 0, which a move of b only shifts (``UnbiasedRun.at_bias``)."""
-    return _draw_tracking(figure, unbiased_runs(sigma_a, sigma_v).at_bias(bias))
+    run at b = 0, which a move of b only shifts (``UnbiasedRun.at_bias``);
+    ``vision_mses(σ_v)`` makes or keeps the vision-only filter's MSE."""
+    return _draw_tracking(figure, unbiased_runs(sigma_a, sigma_v).at_bias(bias),
+                          vision_mses(sigma_v))
 
 
-def _draw_tracking(figure: Figure, tracking: bias_model.InputTracking) -> str:
+def _draw_tracking(figure: Figure, tracking: bias_model.InputTracking,
+                   vision_mse: float) -> str:
     """:func:`draw_bias` for a run already made; returns the numbers of the view."""
     scenario = tracking.scenario
     shown = _shown(scenario)
@@ -199,27 +220,39 @@ def _draw_tracking(figure: Figure, tracking: bias_model.InputTracking) -> str:
     panels.vision.set_ydata(tracking.measurements[shown, 0])
     panels.estimate.set_ydata(tracking.positions[shown])
     panels.dead_reckoning.set_ydata(tracking.dead_reckoning[shown, 0])
-    return _bias_numbers(tracking)
+    return _bias_numbers(tracking, vision_mse)
 
 
-def _bias_numbers(tracking: bias_model.InputTracking) -> str:
-    """The numbers of :func:`draw_bias`'s view of ``tracking`` as one line of text."""
+def _plus_minus(value: float, spread: float) -> str:
+    """``value ± spread`` with the spread to 2 significant figures and the value to as many
+    decimals ("19.93 ± 0.31", "20.012 ± 0.031", "21 ± 13"), so neither prints as 0.0."""
+    decimals = max(0, 1 - math.floor(math.log10(spread))) if spread > 0 else 2
+    return f"{value:.{decimals}f} ± {spread:.{decimals}f}"
+
+
+def _bias_numbers(tracking: bias_model.InputTracking, vision_mse: float) -> str:
+    """The numbers of :func:`draw_bias`'s view of ``tracking`` as one line of text.
+
+    ``vision_mse`` is the vision-only filter's MSE (cm²) on the same camera noise
+    (:func:`_vision_only_mse`). MSEs to 3 significant figures, b̂ ± 2σ by :func:`_plus_minus`.
+    """
     scenario = tracking.scenario
     end_error = float(tracking.dead_reckoning[-1, 0] - tracking.truth[-1, 0])
-    return (f"True bias b = {tracking.bias:g} cm/s²; its estimate at {scenario.duration:g} s: "
-            f"{tracking.bias_estimates[-1]:.1f} ± {2 * tracking.bias_stds[-1]:.1f} cm/s². "
-            f"MSE of the filtered position after {scenario.burn_in:g} s: "
-            f"{float(tracking.mse()):.3g} cm²; dead reckoning ends {end_error:+.0f} cm off "
-            f"the path at {scenario.duration:g} s.")
+    estimate = _plus_minus(float(tracking.bias_estimates[-1]), 2 * float(tracking.bias_stds[-1]))
+    return (f"The pack's filter with the signal as input (bias_model). True bias "
+            f"b = {tracking.bias:g} cm/s²; its estimate at {scenario.duration:g} s: {estimate} "
+            f"cm/s². MSE of the filtered position after {scenario.burn_in:g} s: "
+            f"{float(tracking.mse()):.3g} cm² (vision-only filter on the same camera noise: "
+            f"{vision_mse:.3g} cm²); dead reckoning ends {end_error:+.0f} cm off the path at "
+            f"{scenario.duration:g} s.")
 
 
 def describe_bias(*, bias: float, sigma_a: float, sigma_v: float) -> str:
     """What :func:`draw_bias` shows at these slider values (its alt text)."""
     return (f"First {WINDOW:g} s of one run with an acceleration signal biased by "
             f"b = {bias:g} cm/s² and noise σ_a = {sigma_a:.3g} cm/s², vision at "
-            f"σ_v = {sigma_v:.1f} cm. Left: the bias estimate with its ±2σ band approaching "
-            f"the true bias; right: true path, vision, filtered estimate and dead reckoning "
-            f"drifting away.")
+            f"σ_v = {sigma_v:.1f} cm. Left: the bias estimate with its ±2σ band and the true "
+            f"bias; right: true path, vision, filtered estimate and dead reckoning.")
 
 
 def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
@@ -253,7 +286,8 @@ def explore_bias(scenario: Scenario = DEFAULT) -> Explorer:
         "A biased acceleration signal corrected by vision",
         sliders,
         partial(_draw, unbiased_runs=LastResults(partial(bias_model.unbiased_run, scenario,
-                                                         noise=noise))),
+                                                         noise=noise)),
+                vision_mses=LastResults(partial(_vision_only_mse, scenario, noise=noise))),
         figsize=(10.0, 4.6),
         describe=describe_bias,
     )

@@ -66,8 +66,8 @@ def open_loop_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
                     linewidth=0, label="±2σ of the prediction")
     ax.axvline(close, color=COLORS["truth"], linewidth=0.8, linestyle=":")
     label_axes(ax, "time (s)", "position (cm)",
-               f"Eyes closed at t = {close:g} s: the model extrapolates, its uncertainty "
-               "fans out", xlim=(start, end), ylim=(-limit, limit),
+               f"Eyes closed at t = {close:g} s: the prediction and its ±2σ band",
+               xlim=(start, end), ylim=(-limit, limit),
                legend={"loc": "lower left", "ncols": 3, "markerscale": 3, "fontsize": 9})
     fig.tight_layout()
     return fig
@@ -110,8 +110,11 @@ def mse_intervals_figure(labels: list[str], intervals, xlabel: str = "MSE (cm²)
     if reference is not None:
         ax.axvline(reference, **style("reference", linestyle="--", label=reference_label))
     ax.set_yticks(rows, labels)
+    # The legend goes below the axis label (0.55 inch below the axes, whose height is about
+    # 0.6 inch per row), where no row's interval can sit under it.
     label_axes(ax, xlabel, title=title, ylim=(mean.size - 0.5, -0.5),
-               legend={"loc": "lower right", "fontsize": 8})
+               legend={"loc": "upper center", "ncols": 2, "fontsize": 8, "frameon": False,
+                       "bbox_to_anchor": (0.5, -0.55 / (0.6 * mean.size + 0.2))})
     fig.tight_layout()
     return fig
 
