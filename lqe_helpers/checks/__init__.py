@@ -76,7 +76,6 @@ from .fusion_further import (
 from .initial_covariance import (
     check_convergence_times,
     check_initial_covariance,
-    check_initial_covariances,
     check_start_and_after,
     check_start_of_trial,
 )
@@ -152,7 +151,6 @@ __all__ = [
     "check_gain_shares",
     "check_halving",
     "check_initial_covariance",
-    "check_initial_covariances",
     "check_jerk_from_readings",
     "check_jerk_stds",
     "check_jerk_sweep",
