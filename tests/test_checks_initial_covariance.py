@@ -32,7 +32,7 @@ def hand_convergence_time(curve: np.ndarray, dt: float) -> float:
 
 
 # ------------------------------------------------------------------------------------------
-# Task 1: check_initial_covariance (one matrix) and check_initial_covariances (both)
+# check_initial_covariance (one matrix)
 # ------------------------------------------------------------------------------------------
 
 
@@ -68,31 +68,8 @@ def test_check_initial_covariance_names_a_bad_argument(P0, variance, phrase) -> 
     assert_fails(phrase, checks.check_initial_covariance, P0, variance)
 
 
-def test_check_initial_covariances_passes_the_worked_solution(capsys) -> None:
-    line = assert_passes(capsys, checks.check_initial_covariances, P0_SMALL, P0_LARGE)
-    assert "P0_small = 1 · I and P0_large = 100000 · I" in line
-    assert "to 1e-9 relative" in line
-
-
-@pytest.mark.parametrize(("small", "large", "phrase"), [
-    (P0_LARGE, P0_SMALL, "P0_small is diag(100000, 100000, 100000), the other start: "
-                         "P0_small and P0_large are swapped"),
-    (P0_LARGE, P0_LARGE, "P0_small is diag(100000, 100000, 100000), the other start. "
-                         "P0_small is the confident start, diag(1, 1, 1)"),
-    (P0_SMALL, np.sqrt(1e5) * np.eye(3), "P0_large's diagonal holds √100000 = 316.228, a "
-                                         "standard deviation"),
-    (P0_SMALL, np.full((3, 3), 1e5), "every entry of P0_large is 100000"),
-    (np.ones(3), P0_LARGE, "P0_small is a vector of 3 numbers"),
-    (1.0, P0_LARGE, "P0_small is a single number (1)"),
-    (P0_SMALL, np.diag([1e-5, 1e-5, 1e-5]), "P0_large's diagonal holds 1e-05, expected the "
-                                            "variance 100000"),
-])
-def test_check_initial_covariances_names_each_typical_mistake(small, large, phrase) -> None:
-    assert_fails(phrase, checks.check_initial_covariances, small, large)
-
-
 # ------------------------------------------------------------------------------------------
-# Task 2: check_start_of_trial, the student's filter on one trial
+# Task 1: check_start_of_trial, both P0 and the student's filter on one trial from each
 # ------------------------------------------------------------------------------------------
 
 
@@ -113,8 +90,31 @@ def run(trial: dict[str, np.ndarray], P0: np.ndarray, **changed: np.ndarray) -> 
 
 
 def test_check_start_of_trial_passes_the_worked_solution(capsys, trial) -> None:
-    line = assert_passes(capsys, checks.check_start_of_trial, trial["small"], trial["large"])
+    line = assert_passes(capsys, checks.check_start_of_trial, P0_SMALL, P0_LARGE,
+                         trial["small"], trial["large"])
+    assert "P0_small = 1 · I and P0_large = 100000 · I" in line
     assert "match the pack's engine on this trial" in line and "to 1e-9" in line
+
+
+@pytest.mark.parametrize(("small", "large", "phrase"), [
+    (P0_LARGE, P0_SMALL, "P0_small is diag(100000, 100000, 100000), the other start: "
+                         "P0_small and P0_large are swapped"),
+    (P0_LARGE, P0_LARGE, "P0_small is diag(100000, 100000, 100000), the other start. "
+                         "P0_small is the confident start, diag(1, 1, 1)"),
+    (P0_SMALL, np.sqrt(1e5) * np.eye(3), "P0_large's diagonal holds √100000 = 316.228, a "
+                                         "standard deviation"),
+    (P0_SMALL, np.full((3, 3), 1e5), "every entry of P0_large is 100000"),
+    (np.ones(3), P0_LARGE, "P0_small is a vector of 3 numbers"),
+    (1.0, P0_LARGE, "P0_small is a single number (1)"),
+    (P0_SMALL, np.diag([1e-5, 1e-5, 1e-5]), "P0_large's diagonal holds 1e-05, expected the "
+                                            "variance 100000"),
+])
+def test_check_start_of_trial_names_each_typical_mistake_in_p0(trial, small, large,
+                                                                phrase) -> None:
+    """A wrong P0 is named first, whatever the estimates (here those of that P0)."""
+    estimates = [run(trial, np.asarray(P0) * np.eye(3)) if np.ndim(P0) < 2 else run(trial, P0)
+                 for P0 in (small, large)]
+    assert_fails(phrase, checks.check_start_of_trial, small, large, *estimates)
 
 
 def test_check_start_of_trial_names_each_typical_mistake(trial) -> None:
@@ -137,11 +137,11 @@ def test_check_start_of_trial_names_each_typical_mistake(trial) -> None:
          (run(trial, P0_SMALL, Q=np.zeros((3, 3))), large)),
     ]
     for phrase, answer in cases:
-        assert_fails(phrase, checks.check_start_of_trial, *answer)
+        assert_fails(phrase, checks.check_start_of_trial, P0_SMALL, P0_LARGE, *answer)
 
 
 # ------------------------------------------------------------------------------------------
-# Task 3: check_convergence_times
+# Task 2: check_convergence_times
 # ------------------------------------------------------------------------------------------
 
 
@@ -198,7 +198,7 @@ def test_check_convergence_times_names_each_typical_mistake(batch, squared, time
 
 
 # ------------------------------------------------------------------------------------------
-# Task 4: check_start_and_after
+# Task 3: check_start_and_after
 # ------------------------------------------------------------------------------------------
 
 

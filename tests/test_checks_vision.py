@@ -301,7 +301,7 @@ def test_check_filter_refuses_a_filter_that_patches_the_engine() -> None:
 
 
 # ------------------------------------------------------------------------------------------
-# check_vision_mse (Task 2)
+# check_vision_trial (Task 2)
 # ------------------------------------------------------------------------------------------
 
 TRUTH = DEFAULT.truth[:, 0]
@@ -310,73 +310,81 @@ BURN = DEFAULT.burn_in_steps
 C_VISION = np.array([[1.0, 0.0, 0.0]])
 
 
-def task2(slip: str = "") -> tuple[dict, dict]:
-    """Task 2 as a student writes it (the notebook's worked code), with one ``slip``."""
-    burn = int(DEFAULT.burn_in) if slip == "burn in seconds" else BURN
-    burn = 0 if slip == "whole trial" else burn
-    R = np.array([[DEFAULT.sigma_v**2]])                    # used if R is never updated
-    mse_readings, mse_filtered = {}, {}
-    for sigma_v in (1.5, 4.5):
-        y = TRUTH[:, None] + (1.0 if slip == "no sigma in y" else sigma_v) * NOISE
-        if slip == "R = sigma":
-            R = np.array([[sigma_v]])
-        elif slip != "R not updated":
-            R = np.array([[sigma_v**2]])
-        estimates = reference.lqe_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, R, np.zeros(3),
-                                         DEFAULT.P0)
-        errors_raw = y[burn:, 0] - TRUTH[burn:]
-        errors_filtered = (y[burn:, 0] if slip == "readings twice" else estimates[burn:, 0]) \
-            - TRUTH[burn:]
-        mse_readings[sigma_v] = np.mean(errors_raw**2)
-        mse_filtered[sigma_v] = np.mean(errors_filtered**2)
-        if slip == "rmse":
-            mse_readings[sigma_v] = np.sqrt(mse_readings[sigma_v])
-            mse_filtered[sigma_v] = np.sqrt(mse_filtered[sigma_v])
-    return mse_readings, mse_filtered
+def task2(slip: str = ""):
+    """Task 2's vision_trial as a student writes it (the notebook's worked code), one ``slip``.
+
+    Its filter is a student's loop (``student_filter``), as the notebook's my_filter is.
+    """
+    def vision_trial(sigma_v):
+        scale = {"sigma squared in y": sigma_v**2, "no sigma in y": 1.0,
+                 "always 1.5": 1.5}.get(slip, sigma_v)
+        if slip == "truth not a column":
+            y = TRUTH + scale * NOISE                               # (n, n)
+        elif slip == "flat":
+            y = TRUTH + scale * NOISE[:, 0]                         # (n,)
+        else:
+            y = TRUTH[:, None] + scale * NOISE
+        R = np.array([[{"R = sigma": sigma_v, "R = sigma^4": sigma_v**4,
+                        "always 1.5": 1.5**2}.get(slip, sigma_v**2)]])
+        estimates = student_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, R, np.zeros(3),
+                                   DEFAULT.P0)
+        if slip == "positions only":
+            return y, estimates[:, 0]
+        if slip == "estimates only":
+            return estimates
+        if slip == "no return":
+            return None
+        if slip == "engine":
+            return y, experiments.track(DEFAULT, sigmas=[sigma_v]).result.estimates
+        return y, estimates
+    return vision_trial
 
 
-def test_check_vision_mse_passes_the_worked_answer(capsys) -> None:
-    line = assert_passes(capsys, checks.check_vision_mse, *task2())
-    assert "σ_v = 1.5 and 4.5 cm" in line and "to 1e-6 relative" in line
+def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
+    line = assert_passes(capsys, checks.check_vision_trial, task2())
+    assert "vision_trial at σ_v = 1.5 and 4.5 cm" in line and "to 1e-9" in line
 
 
 @pytest.mark.parametrize(("slip", "phrase"), [
-    ("R = sigma", "mse_filtered[1.5] = 0.317"),
-    ("R = sigma", "R holds σ_v (cm) where its variance σ_v² (cm²) belongs"),
-    ("whole trial", "mse_readings[1.5] = 2.05374 cm² is not right: it is the MSE of the whole "
-                    "trial"),
-    ("burn in seconds", "it leaves out the first 1 sample(s): the burn-in is 1 s, which is 100 "
-                        "samples"),
-    ("R not updated", "mse_filtered[4.5] = 2.62341 cm² is not right"),
-    ("R not updated", "R is that of σ_v = 1.5 cm"),
+    ("truth not a column", "truth + σ_v · noise broadcasts to (n, n); the readings are "
+                           "truth[:, None] + σ_v · noise, shape (n, 1)"),
+    ("flat", "the readings y that vision_trial(1.5) returns are flat, shape (1000,)"),
+    ("sigma squared in y", "the readings y that vision_trial(1.5) returns is not right: the "
+                           "readings were made with σ_v² instead of σ_v"),
     ("no sigma in y", "the readings were made without σ_v (truth + noise)"),
-    ("rmse", "it is the root mean squared error (RMSE, in cm)"),
-    ("readings twice", "mse_filtered[1.5] = 2.03754 cm² is not right: it is the MSE of the raw "
-                       "readings"),
+    ("R = sigma", "the estimates that vision_trial(1.5) returns is not right: R holds σ_v "
+                  "(cm) where its variance σ_v² (cm²) belongs"),
+    ("R = sigma^4", "R holds σ_v⁴"),
+    ("always 1.5", "vision_trial(4.5) returns is not right: they are the readings of σ_v = "
+                   "1.5 cm"),
+    ("positions only", "hold one number per reading (the positions only?)"),
+    ("estimates only", "vision_trial(1.5) must return two things, the readings y and the "
+                       "estimates"),
+    ("no return", "got None (nothing): does it end with `return y, estimates`?"),
+    ("engine", "vision_trial runs the pack's own lqe_helpers.filter.kalman_filter"),
 ])
-def test_check_vision_mse_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
-    assert_fails(phrase, checks.check_vision_mse, *task2(slip))
+def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
+    assert_fails(phrase, checks.check_vision_trial, task2(slip))
 
 
-def test_check_vision_mse_catches_r_as_sigma_that_only_arithmetic_checks_would_pass() -> None:
-    """The bug of issue 15: R = [[σ_v]] agrees with its own positions, not with the science."""
-    readings, filtered = task2("R = sigma")
-    assert abs(filtered[4.5] / task2()[1][4.5] - 1) > 0.1         # about 18 % off
-    assert_fails("R holds σ_v", checks.check_vision_mse, readings, filtered)
+def test_check_vision_trial_catches_r_as_sigma_that_only_arithmetic_checks_would_pass() -> None:
+    """The bug of issue 15: R = [[σ_v]] gives estimates consistent with themselves only."""
+    y, wrong = task2("R = sigma")(4.5)
+    right = reference.lqe_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, np.array([[4.5**2]]),
+                                 np.zeros(3), DEFAULT.P0)
+    assert abs(metrics.mse(wrong[:, 0], TRUTH, BURN) / metrics.mse(right[:, 0], TRUTH, BURN)
+               - 1) > 0.1                                      # about 18 % off
+    assert_fails("R holds σ_v", checks.check_vision_trial, task2("R = sigma"))
 
 
-def test_check_vision_mse_wants_both_noise_levels_as_numbers() -> None:
-    readings, filtered = task2()
-    assert_fails("mse_readings must be a dict of MSEs (cm²) of the readings keyed by σ_v",
-                 checks.check_vision_mse, readings[4.5], filtered)
-    assert_fails("mse_filtered has no entry for σ_v = 1.5 cm (its keys: '1.5', '4.5')",
-                 checks.check_vision_mse, readings, {str(k): v for k, v in filtered.items()})
-    assert_fails("mse_filtered[4.5] must be one number (cm²), got True (a boolean)",
-                 checks.check_vision_mse, readings, {**filtered, 4.5: True})
-    assert_fails("mse_filtered[1.5] must be one number (cm²), got a complex number",
-                 checks.check_vision_mse, readings, {**filtered, 1.5: filtered[1.5] + 0j})
-    assert_fails("mse_readings[1.5] must be one number (cm²), got an array of shape (2,)",
-                 checks.check_vision_mse, {**readings, 1.5: np.ones(2)}, filtered)
+def test_check_vision_trial_without_a_function_or_before_it_is_written() -> None:
+    assert_fails("check_vision_trial needs your function vision_trial itself",
+                 checks.check_vision_trial, task2()(1.5))
+
+    def vision_trial(sigma_v):
+        raise NotImplementedError("Replace this line with your code")
+
+    assert_fails("vision_trial is not written yet", checks.check_vision_trial, vision_trial)
 
 
 # ------------------------------------------------------------------------------------------
@@ -424,7 +432,8 @@ def test_check_vision_difference_passes_the_worked_answer(capsys) -> None:
     ("ratio", "it is the interval of the ratio raw / filtered"),
     ("separate intervals", "it combines the two separate intervals"),
     ("difference of means", "improvement[1.5] is a number; it must be the metrics.Interval"),
-    ("rows", "improvement[1.5] is over 2 runs, but the task has 300"),
+    ("rows", "improvement[1.5] is over 2 values, a row of mse_raw and mse_est (one run at both "
+             "noise levels): rows and columns are mixed up"),
 ])
 def test_check_vision_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_difference, task3(slip))

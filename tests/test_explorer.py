@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 import numpy as np
 import pytest
+import traitlets
 from explorer_checks import png
 from matplotlib.axes import Axes
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -107,6 +108,24 @@ def test_float_slider_refuses_what_ipywidgets_would_clip_or_break(arguments, mes
 def test_log_slider_refuses_what_ipywidgets_would_clip_or_break(arguments, message):
     with pytest.raises(ValueError, match=message):
         log_slider("P0 (cm²)", *arguments)
+
+
+def test_a_value_set_from_code_outside_the_range_raises_instead_of_being_clipped():
+    """ipywidgets clips it without a word: P0 set to the exponent -2 would become 0.01."""
+    logarithmic = log_slider("P0 (cm²)", 1.0, 1e-2, 1e6)
+    with pytest.raises(traitlets.TraitError, match=r"'P0 \(cm²\)' takes values in \[0\.01, "
+                                                   r"1e\+06\], got -2: the value itself, not "
+                                                   r"its exponent"):
+        logarithmic.value = -2
+    assert logarithmic.value == pytest.approx(1.0)
+    linear = float_slider("σ_v (cm)", 1.5, 0.1, 10.0, 0.1)
+    with pytest.raises(traitlets.TraitError, match=r"takes values in \[0\.1, 10\], got 20$"):
+        linear.value = 20.0
+    assert linear.value == 1.5
+    # The ends themselves, as the browser computes them (10 ** exponent), are in range.
+    logarithmic.value = 10 ** 6.0
+    linear.value = 0.1
+    assert (logarithmic.value, linear.value) == (1e6, 0.1)
 
 
 def test_slider_ends_are_valid_starting_values():

@@ -7,6 +7,7 @@ import html
 
 import numpy as np
 import pytest
+import traitlets
 from explorer_checks import EXPLORER_SCENARIO, assert_only_numbers_change, band_matches, line, png
 from matplotlib.figure import Figure
 
@@ -39,6 +40,17 @@ def test_slider_is_logarithmic_over_the_documented_range(explorer) -> None:
         assert position == pytest.approx(round(position))
 
 
+def test_an_exponent_set_from_code_is_refused_not_clipped(explorer) -> None:
+    """P0 = 10⁻² set as -2 raises; ipywidgets alone clipped it to 0.01 and drew that."""
+    numbers = explorer.numbers
+    with pytest.raises(traitlets.TraitError, match=r"the value itself, not its exponent"):
+        explorer.sliders["p0_variance"].value = -2
+    assert explorer.sliders["p0_variance"].value == DEFAULT.p0_variance
+    assert explorer.numbers == numbers
+    explorer.sliders["p0_variance"].value = 1e-2
+    assert explorer.numbers.startswith("The pack's engine, P0 = 0.01 · I. ")
+
+
 @pytest.mark.parametrize("p0_variance", [1e-2, 1e5, 1e6, 1.0])
 def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance) -> None:
     explorer.sliders["p0_variance"].value = p0_variance
@@ -66,8 +78,8 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance)
     early = metrics.mse(expected.positions[:burn], truth[:burn, 0])
     late = metrics.mse(expected.positions, truth[:, 0], burn)
     assert explorer.numbers == (f"The pack's engine, P0 = {p0_variance:.3g} · I. Position MSE "
-                                f"of this run: {early:.2f} cm² in the first "
-                                f"{DEFAULT.burn_in:g} s, {late:.2f} cm² after.")
+                                f"of this run: {early:.3g} cm² in the first "
+                                f"{DEFAULT.burn_in:g} s, {late:.3g} cm² after.")
     assert explorer.figure.get_suptitle() == ""
 
 
@@ -215,7 +227,7 @@ def test_the_explorer_draws_what_the_students_filter_returns() -> None:
     positions = experiments.track(DEFAULT, p0_variance=1.0).positions + 0.5  # draw's default
     late = metrics.mse(positions, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
     assert numbers.startswith("Your shifted_filter, P0 = 1 · I. ")
-    assert numbers.endswith(f"{late:.2f} cm² after.")
+    assert numbers.endswith(f"{late:.3g} cm² after.")
 
 
 def test_an_explorer_of_the_students_filter_says_whose_it_is() -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import html
+import re
 
 import numpy as np
 import pytest
@@ -59,10 +60,23 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: flo
     filtered = np.mean((expected.positions - truth)[DEFAULT.burn_in_steps:] ** 2)
     assert explorer.numbers == (f"σ_v = {sigma_v:.1f} cm, filtered by the pack's engine. "
                                 f"MSE of this run after {DEFAULT.burn_in:g} s: raw vision "
-                                f"{raw:.2f} cm², filtered {filtered:.2f} cm².")
+                                f"{raw:.3g} cm², filtered {filtered:.3g} cm², ratio raw / "
+                                f"filtered {raw / filtered:.3g}.")
     assert ax.get_title() == ""
     if sigma_v != DEFAULT.sigma_v:
         assert explorer.png != previous_png
+
+
+@pytest.mark.parametrize("sigma_v", [vision.SIGMA_V_RANGE[0], 1.5, vision.SIGMA_V_RANGE[1]])
+def test_numbers_line_keeps_three_significant_figures_at_every_slider_value(explorer,
+                                                                          sigma_v) -> None:
+    """At σ_v = 0.1 cm the MSEs are about 0.01 cm²: a fixed two decimals printed "0.00"."""
+    explorer.sliders["sigma_v"].value = sigma_v
+    raw, filtered, ratio = (float(text) for text in re.findall(
+        r"raw vision (\S+) cm², filtered (\S+) cm², ratio raw / filtered (\S+)\.$",
+        explorer.numbers)[0])
+    assert min(raw, filtered, ratio) > 0
+    assert raw / filtered == pytest.approx(ratio, rel=1e-2)
 
 
 def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
@@ -91,7 +105,8 @@ def test_draw_function_on_a_fresh_figure_with_given_noise() -> None:
     expected = experiments.track(DEFAULT, sigmas=[2.0], noise=noise)
     np.testing.assert_allclose(line(ax, vision.ESTIMATE_LABEL), expected.positions,
                                rtol=0, atol=1e-12)
-    assert f"raw vision 0.00 cm², filtered {float(expected.mse()):.2f} cm²." in numbers
+    assert (f"raw vision 0 cm², filtered {float(expected.mse()):.3g} cm², ratio raw / "
+            f"filtered 0." in numbers)
     # Drawing again replaces, not adds.
     vision.draw_vision(figure, sigma_v=3.0, noise=noise)
     assert len(figure.axes) == 1
@@ -214,7 +229,7 @@ def test_the_drawing_shows_what_the_students_filter_returns() -> None:
     band_matches(ax, vision.BAND_LABEL, expected.positions + 1.0 - 2 * std,
                  expected.positions + 1.0 + 2 * std)
     filtered = metrics.mse(expected.positions + 1.0, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps)
-    assert numbers.endswith(f"filtered {filtered:.2f} cm².")
+    assert f"filtered {filtered:.3g} cm², ratio" in numbers
     assert "filtered by your off_by_one." in numbers
 
 

@@ -29,6 +29,13 @@ def test_tracking_comparison_figure_draws_estimates_and_their_errors():
         error = next(line for line in bottom.get_lines() if line.get_label() == "fused")
         np.testing.assert_allclose(error.get_ydata(), estimate - truth)
         assert top.get_title() == "σ_v = 1.5 cm"
+        # The legend sits above the panel (under the title), not over the data.
+        renderer = fig.canvas.get_renderer()
+        legend, panel = top.get_legend().get_window_extent(renderer), top.get_window_extent()
+        title = top.title.get_window_extent(renderer)
+        assert panel.y1 <= legend.y0 and legend.y1 <= title.y0
+        assert [text.get_text() for text in top.get_legend().get_texts()] == [
+            "vision", "true position", "fused"]
     finally:
         plt.close(fig)
 
@@ -62,6 +69,12 @@ def test_start_up_figure_shows_position_and_velocity_up_to_until():
         shown = times <= 1.0
         np.testing.assert_array_equal(ax_p.get_lines()[1].get_ydata(), estimate[shown, 0])
         np.testing.assert_array_equal(ax_v.get_lines()[1].get_ydata(), estimate[shown, 1])
+        # The legend sits between the position panel and its title, clear of the data.
+        renderer = fig.canvas.get_renderer()
+        legend = ax_p.get_legend().get_window_extent(renderer)
+        assert ax_p.get_window_extent().y1 <= legend.y0
+        assert legend.y1 <= ax_p.title.get_window_extent(renderer).y0
+        assert ax_p.get_title() == "Position"
     finally:
         plt.close(fig)
     with pytest.raises(ValueError, match="until"):

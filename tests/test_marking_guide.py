@@ -17,7 +17,7 @@ ROOT = Path(__file__).resolve().parents[1]
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 TASK = ("# Task: compute the fused MSE after the burn-in (cm²) with metrics.mse\n"
         "#       and print it.\nmse = metrics.mse(estimate, truth)\nprint(f'{mse:.3f}')")
-CHECK = "checks.check_vision_mse(mse_readings, mse_filtered)"
+CHECK = "checks.check_steady_state(forecast, coverage)"
 ANSWER = ("#### Answer to (c): does fusion help?\n\n"
           "- Yes: the fused MSE is below vision's, every paired interval above zero.\n"
           "- Two equal senses act as one at σ/√2.")

@@ -56,7 +56,7 @@ def worked_notebook(*, solution: str = SOLUTION, tags: tuple[str, ...] = ("solut
     """A small executed worked notebook: title, setup, one task with its check, an answer."""
     task = new_code_cell(solution, metadata={"tags": list(tags)}, execution_count=2,
                          outputs=[new_output("stream", name="stdout", text="MSE = 1.0 cm²\n")])
-    check = new_code_cell("checks.check_vision_mse(mse, mse)", execution_count=3,
+    check = new_code_cell("checks.check_steady_state(mse, mse)", execution_count=3,
                           outputs=[new_output("stream", name="stdout", text="✓ right\n")])
     cells = [
         new_markdown_cell("# A worked notebook\n\nWhat will you learn?"),

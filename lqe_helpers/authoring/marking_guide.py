@@ -162,7 +162,7 @@ def check_tolerance(call: str) -> str:
     Parameters
     ----------
     call : str
-        The check cell's source, e.g. ``checks.check_vision_mse(mse_readings, mse_filtered)``.
+        The check cell's source, e.g. ``checks.check_steady_state(forecast, coverage)``.
 
     Returns
     -------

@@ -76,7 +76,6 @@ from .fusion_further import (
 from .initial_covariance import (
     check_convergence_times,
     check_initial_covariance,
-    check_initial_covariances,
     check_start_and_after,
     check_start_of_trial,
 )
@@ -108,7 +107,7 @@ from .noisier_proprioception_further import (
     check_proprioception_sweep,
     check_sweep_reading,
 )
-from .vision import check_filter, check_vision_difference, check_vision_mse
+from .vision import check_filter, check_vision_difference, check_vision_trial
 from .vision_further import (
     check_nis,
     check_sampling_ratio,
@@ -152,7 +151,6 @@ __all__ = [
     "check_gain_shares",
     "check_halving",
     "check_initial_covariance",
-    "check_initial_covariances",
     "check_jerk_from_readings",
     "check_jerk_stds",
     "check_jerk_sweep",
@@ -187,6 +185,6 @@ __all__ = [
     "check_transition_matrix",
     "check_uncertainty_growth",
     "check_vision_difference",
-    "check_vision_mse",
+    "check_vision_trial",
     "check_white_jerk",
 ]

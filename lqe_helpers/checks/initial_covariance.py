@@ -2,14 +2,13 @@
 
 The core path's tasks, each judged against the pack's engine on the task's own draw:
 
-- :func:`check_initial_covariances` (Task 1): ``P0_small = diag(1, 1, 1)`` and
-  ``P0_large = diag(10⁵, 10⁵, 10⁵)``, variances on the diagonal;
-- :func:`check_start_of_trial` (Task 2): the student's ``my_filter`` run on one trial
-  from each P0, against :meth:`~lqe_helpers.experiments.FilterModel.filter` on the
-  scenario's draw;
-- :func:`check_convergence_times` (Task 3): the convergence time of the Monte Carlo
+- :func:`check_start_of_trial` (Task 1): ``P0_small = diag(1, 1, 1)`` and
+  ``P0_large = diag(10⁵, 10⁵, 10⁵)``, variances on the diagonal, and the student's
+  ``my_filter`` run on one trial from each, against
+  :meth:`~lqe_helpers.experiments.FilterModel.filter` on the scenario's draw;
+- :func:`check_convergence_times` (Task 2): the convergence time of the Monte Carlo
   mean squared error from each P0, recomputed with :func:`~lqe_helpers.experiments.track`;
-- :func:`check_start_and_after` (Task 4): the paired differences diag(1) − diag(10⁵) of
+- :func:`check_start_and_after` (Task 3): the paired differences diag(1) − diag(10⁵) of
   the MSE over the first second and after it.
 
 :func:`check_initial_covariance` checks one matrix against one variance. The checks of
@@ -67,7 +66,7 @@ def squared_errors() -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------
-# Task 1: the two initial covariances
+# Task 1: the two initial covariances (judged with the start of one trial)
 # ------------------------------------------------------------------------------------------
 
 def _p0_problem(P0: object, variance: float, name: str) -> str | None:
@@ -135,22 +134,11 @@ def check_initial_covariance(P0: np.ndarray, variance: float) -> None:
     passed(f"P0 = {variance:g} · I (3 × 3, diagonal) cm²")
 
 
-def check_initial_covariances(P0_small: np.ndarray, P0_large: np.ndarray) -> None:
-    """Check Task 1: ``P0_small = diag(1, 1, 1)`` and ``P0_large = diag(10⁵, 10⁵, 10⁵)``.
+def _judge_covariances(P0_small: object, P0_large: object) -> None:
+    """CheckFailed unless ``P0_small = diag(1, 1, 1)`` and ``P0_large = diag(10⁵, 10⁵, 10⁵)``.
 
-    Each must be a 3 × 3 diagonal matrix with the question's variance (cm², cm²/s²,
-    cm²/s⁴) on its diagonal, within :data:`MATRIX_RTOL` relative.
-
-    Parameters
-    ----------
-    P0_small, P0_large : array_like, shape (3, 3)
-        The student's initial covariances: the confident and the uncertain start.
-
-    Raises
-    ------
-    CheckFailed
-        Naming the matrix: the two swapped, a single number, a vector, a wrong size,
-        off-diagonal entries, standard deviations instead of variances, other values.
+    Names the matrix: the two swapped, a single number, a vector, a wrong size,
+    off-diagonal entries, standard deviations instead of variances, other values.
     """
     given = {"P0_small": P0_small, "P0_large": P0_large}
     for index, (name, P0) in enumerate(given.items()):
@@ -167,13 +155,10 @@ def check_initial_covariances(P0_small: np.ndarray, P0_large: np.ndarray) -> Non
                 + f". {name} is the {'confident' if index == 0 else 'uncertain'} start, "
                   f"diag({variance:g}, {variance:g}, {variance:g})")
         raise CheckFailed(problem)
-    passed(f"P0_small = {QUESTION_P0[0]:g} · I and P0_large = {QUESTION_P0[1]:g} · I: 3 × 3, "
-           f"variances on the diagonal (cm², cm²/s², cm²/s⁴), to {tolerance_text(MATRIX_RTOL)} "
-           f"relative")
 
 
 # ------------------------------------------------------------------------------------------
-# Task 2: one trial, the student's filter from each P0
+# Task 1: one trial, the student's filter from each P0
 # ------------------------------------------------------------------------------------------
 
 def _trial_estimates(p0_variance: float, *, z0: np.ndarray | None = None,
@@ -189,7 +174,7 @@ def _trial_estimates(p0_variance: float, *, z0: np.ndarray | None = None,
 
 @functools.cache
 def _trial() -> dict[str, np.ndarray]:
-    """The right estimates of Task 2 and the likely mistakes, each (n, 3)."""
+    """The right estimates of Task 1 and the likely mistakes, each (n, 3)."""
     right = {name: _trial_estimates(p0) for name, p0 in zip(_SMALL_LARGE, QUESTION_P0,
                                                                strict=True)}
     sigma_v = DEFAULT.sigma_v
@@ -204,17 +189,23 @@ def _trial() -> dict[str, np.ndarray]:
     }
 
 
-def check_start_of_trial(estimates_small: np.ndarray, estimates_large: np.ndarray) -> None:
-    """Check Task 2: the student's filter on one trial, from P0 = diag(1) and diag(10⁵).
+def check_start_of_trial(P0_small: np.ndarray, P0_large: np.ndarray,
+                         estimates_small: np.ndarray, estimates_large: np.ndarray) -> None:
+    """Check Task 1: both P0, and the student's filter on one trial from each.
 
-    Recomputed before looking at the student's arrays: the scenario's trial of vision
-    at σ_v (``experiments.track(DEFAULT).measurements``) filtered by the pack's engine
-    with the model of :func:`~lqe_helpers.experiments.filter_model` and each P0. Every
-    estimate must agree within :data:`FUNCTION_RTOL` of the largest one, as
-    ``check_filter`` of notebook 01 asks of ``my_filter``.
+    First ``P0_small = diag(1, 1, 1)`` and ``P0_large = diag(10⁵, 10⁵, 10⁵)``: 3 × 3
+    diagonal matrices of the question's variance (cm², cm²/s², cm²/s⁴), within
+    :data:`MATRIX_RTOL` relative. Then the estimates, recomputed before looking at
+    them: the scenario's trial of vision at σ_v (``experiments.track(DEFAULT)``)
+    filtered by the pack's engine with the model of
+    :func:`~lqe_helpers.experiments.filter_model` and each P0. Every estimate must agree
+    within :data:`FUNCTION_RTOL` of the largest one, as ``check_filter`` of notebook 01
+    asks of ``my_filter``.
 
     Parameters
     ----------
+    P0_small, P0_large : array_like, shape (3, 3)
+        The student's initial covariances: the confident and the uncertain start.
     estimates_small, estimates_large : array_like, shape (n, 3)
         The student's estimates (position cm, velocity cm/s, acceleration cm/s²) after
         each reading, from P0 = diag(1) and from P0 = diag(10⁵).
@@ -222,10 +213,13 @@ def check_start_of_trial(estimates_small: np.ndarray, estimates_large: np.ndarra
     Raises
     ------
     CheckFailed
-        Naming the array and the likely cause: the two swapped or both from one P0,
-        positions only, the filter started from the true state, R of σ_v instead of
-        σ_v², P0 of standard deviations, a filter that no longer follows eq. (5).
+        Naming the matrix or array and the likely cause: the two P0 swapped, a single
+        number, a vector, off-diagonal entries, standard deviations instead of
+        variances; the runs swapped or both from one P0, positions only, the filter
+        started from the true state, R of σ_v instead of σ_v², a filter that no longer
+        follows eq. (5).
     """
+    _judge_covariances(P0_small, P0_large)
     runs = _trial()
     n = DEFAULT.n_steps
     given = {"estimates_small": estimates_small, "estimates_large": estimates_large}
@@ -254,13 +248,15 @@ def check_start_of_trial(estimates_small: np.ndarray, estimates_large: np.ndarra
                   "P0 held standard deviations (√p0) on its diagonal, not variances":
                       runs[f"std_{this}"],
               })
-    passed(f"estimates_small and estimates_large match the pack's engine on this trial "
-           f"from P0 = {P0_NAMES[0]} and {P0_NAMES[1]} ({n} readings × 3 states) to "
-           f"{tolerance_text(FUNCTION_RTOL)} of the largest estimate")
+    passed(f"P0_small = {QUESTION_P0[0]:g} · I and P0_large = {QUESTION_P0[1]:g} · I (3 × 3, "
+           f"variances on the diagonal, to {tolerance_text(MATRIX_RTOL)} relative); "
+           f"estimates_small and estimates_large match the pack's engine on this trial from "
+           f"each ({n} readings × 3 states) to {tolerance_text(FUNCTION_RTOL)} of the largest "
+           f"estimate")
 
 
 # ------------------------------------------------------------------------------------------
-# Task 3: convergence times of the Monte Carlo mean
+# Task 2: convergence times of the Monte Carlo mean
 # ------------------------------------------------------------------------------------------
 
 def crossing_times(curve: np.ndarray, dt: float) -> dict[str, float]:
@@ -327,7 +323,7 @@ def judge_seconds(name: str, value: object, expected: float | np.ndarray,
 
 @functools.cache
 def _convergence() -> dict[str, object]:
-    """The right convergence times of Task 3 (s) and their likely mistakes, by P0."""
+    """The right convergence times of Task 2 (s) and their likely mistakes, by P0."""
     squared, dt = squared_errors(), DEFAULT.dt
     runs = question_runs()
     error = runs.positions - DEFAULT.truth[:, 0]
@@ -364,7 +360,7 @@ def _convergence() -> dict[str, object]:
 
 
 def check_convergence_times(t_small: float, t_large: float) -> None:
-    """Check Task 3: the convergence times (s) from P0 = diag(1) and diag(10⁵).
+    """Check Task 2: the convergence times (s) from P0 = diag(1) and diag(10⁵).
 
     Recomputed before looking at the student's values: ``DEFAULT.mc_runs`` runs from
     both P0 on the task's draws (:func:`~lqe_helpers.experiments.track`), the mean over
@@ -404,12 +400,12 @@ def check_convergence_times(t_small: float, t_large: float) -> None:
 
 
 # ------------------------------------------------------------------------------------------
-# Task 4: the start-up and the settled filter, paired
+# Task 3: the start-up and the settled filter, paired
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
 def window_mses() -> dict[str, np.ndarray]:
-    """Per-run position MSEs (cm²), shape (runs, 2), over the windows of Task 4 and its slips.
+    """Per-run position MSEs (cm²), shape (runs, 2), over the windows of Task 3 and its slips.
 
     Keys: ``start`` (the first second), ``after`` (after it), ``whole`` (the whole
     trial), ``one`` (the first sample only), ``start_late`` (the first second and one
@@ -425,7 +421,7 @@ def window_mses() -> dict[str, np.ndarray]:
     return values
 
 
-#: The windows of Task 4, as the messages say them.
+#: The windows of Task 3, as the messages say them.
 _WINDOWS = {"start": "over the first second", "after": "after the first second"}
 
 
@@ -436,7 +432,7 @@ def _paired(mses: np.ndarray) -> metrics.Interval:
 
 def check_start_and_after(start_difference: metrics.Interval,
                           after_difference: metrics.Interval) -> None:
-    """Check Task 4: diag(1) − diag(10⁵), paired, in the MSE over the first second and after.
+    """Check Task 3: diag(1) − diag(10⁵), paired, in the MSE over the first second and after.
 
     Recomputed before looking at the student's intervals: the runs of
     :func:`check_convergence_times`, each run's position MSE (cm²) over the samples before

@@ -228,7 +228,7 @@ def check_overconfidence(overconfidence: np.ndarray) -> None:
     """Check Going further 3: mean squared error over the filter's own variance, first second.
 
     Recomputed before looking at the student's values: the runs of the core path's Task
-    3, the Monte Carlo mean of the squared position error over the samples before
+    2, the Monte Carlo mean of the squared position error over the samples before
     ``DEFAULT.burn_in_steps``, divided by the filter's own variance of its position
     estimate (:attr:`~lqe_helpers.experiments.Tracking.position_variances`), for each P0.
     Within :data:`MSE_RTOL` of the largest ratio.
@@ -303,7 +303,7 @@ def check_convergence_intervals(convergence_small: metrics.Interval,
 
     Recomputed before looking at the student's intervals:
     :func:`metrics.convergence_time_ci95` of each P0's squared errors over the runs of
-    the core path's Task 3. The convergence time itself must agree within
+    the core path's Task 2. The convergence time itself must agree within
     :data:`TIME_ATOL` s; the ends, which depend on the random resampling, within
     :data:`BOOTSTRAP_ATOL` s (any generator seed passes).
 

@@ -2,8 +2,9 @@
 
 - :func:`check_filter` (Task 1): the student's ``my_filter`` on small random models,
   against the pack's engine (:func:`lqe_helpers.filter.kalman_filter`);
-- :func:`check_vision_mse` (Task 2): the raw and filtered MSEs at σ_v = 1.5 and 4.5 cm,
-  recomputed from the scenario's draw with the engine;
+- :func:`check_vision_trial` (Task 2): the student's ``vision_trial(sigma_v)``, the readings
+  and the estimates of one trial at σ_v = 1.5 and 4.5 cm, against the engine on the
+  scenario's draw;
 - :func:`check_vision_difference` (Task 3): the paired raw − filtered difference over
   the Monte Carlo runs, recomputed with :func:`lqe_helpers.experiments.track`.
 
@@ -25,11 +26,10 @@ from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
 from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .judging import interval_mistakes, judge, judge_interval
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
-    MSE_RTOL,
     STOP_CALLING,
     CheckFailed,
     call_student,
@@ -181,62 +181,8 @@ def _filter_output(output: object, name: str, m: FilterCase) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------
-# Task 2: one trial at both noise levels
+# A student's dict keyed by σ_v (Task 3, and the Going further checks)
 # ------------------------------------------------------------------------------------------
-
-def _readings(sigma_v: float, scale: float | None = None) -> np.ndarray:
-    """Vision's readings (n, 1) (cm): truth + scale · the scenario's draw (scale = σ_v)."""
-    noise = DEFAULT.unit_noise(sensors=("vision",))
-    return simulation.measure(DEFAULT.truth[:, 0], noise, [sigma_v if scale is None else scale])
-
-
-def _filtered(readings: np.ndarray, r_variance: float) -> np.ndarray:
-    """Positions (n,) (cm) of the engine on ``readings`` with R = [[r_variance]].
-
-    The tasks' vision-only model (:func:`lqe_helpers.experiments.filter_model`) with its
-    R replaced, so that a slip in R (σ for σ², σ⁴) is filtered exactly as written.
-    """
-    vision = experiments.filter_model(DEFAULT)
-    return dataclasses.replace(vision, R=np.array([[r_variance]])).filter(
-        readings).estimates[:, 0]
-
-
-@functools.cache
-def _trial_mses(sigma_v: float) -> dict[str, object]:
-    """The right MSEs of Task 2 at ``sigma_v`` and the likely mistakes (cm²)."""
-    truth, burn, dt = DEFAULT.truth[:, 0], DEFAULT.burn_in_steps, DEFAULT.dt
-    y = _readings(sigma_v)
-    positions = _filtered(y, sigma_v**2)
-
-    def mse(x: np.ndarray) -> float:
-        return float(metrics.mse(x, truth, burn))
-
-    other = SIGMAS_V[1] if sigma_v == SIGMAS_V[0] else SIGMAS_V[0]
-    raw, filtered = mse(y[:, 0]), mse(positions)
-    filtered_mistakes = {
-        "R holds σ_v (cm) where its variance σ_v² (cm²) belongs, so the filter weighs "
-        "vision wrongly": mse(_filtered(y, sigma_v)),
-        "R holds σ_v⁴: the variance σ_v² was squared again": mse(_filtered(y, sigma_v**4)),
-        f"R is that of σ_v = {other:g} cm: make R from the σ_v of these readings":
-            mse(_filtered(y, other**2)),
-        "it is the MSE of the raw readings, not of the filtered estimate": raw,
-        "the readings were made with σ_v² instead of σ_v (truth + σ_v² · noise)":
-            mse(_filtered(_readings(sigma_v, sigma_v**2), sigma_v**2)),
-        "the readings were made without σ_v (truth + noise): scale the unit noise by σ_v":
-            mse(_filtered(_readings(sigma_v, 1.0), sigma_v**2)),
-        **mse_mistakes(positions, truth, burn, dt),
-    }
-    raw_mistakes = {
-        "it is the MSE of the filtered estimate, not of the raw readings": filtered,
-        "the readings were made with σ_v² instead of σ_v (truth + σ_v² · noise)":
-            mse(_readings(sigma_v, sigma_v**2)[:, 0]),
-        "the readings were made without σ_v (truth + noise): scale the unit noise by σ_v":
-            mse(_readings(sigma_v, 1.0)[:, 0]),
-        **mse_mistakes(y[:, 0], truth, burn, dt),
-    }
-    return {"raw": raw, "filtered": filtered, "raw_mistakes": raw_mistakes,
-            "filtered_mistakes": filtered_mistakes, "other": other}
-
 
 def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS_V,
           key: str = "σ_v", unit: str = "cm") -> dict[float, object]:
@@ -272,43 +218,129 @@ def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS
                f"{unit}, keyed by the number {key} itself")
 
 
-def check_vision_mse(mse_readings: dict[float, float], mse_filtered: dict[float, float]) -> None:
-    """Check Task 2's MSEs of the raw readings and of the filtered estimate at both σ_v.
+# ------------------------------------------------------------------------------------------
+# Task 2: one trial at both noise levels
+# ------------------------------------------------------------------------------------------
 
-    Recomputed from the task's own inputs before looking at the student's: the readings
-    ``truth + σ_v · noise`` of the scenario's draw at σ_v = 1.5 and 4.5 cm, filtered by
-    the pack's engine with ``R = [[σ_v²]]``, ``C = [[1, 0, 0]]``, ``DEFAULT.A``,
-    ``DEFAULT.Q``, z0 and ``DEFAULT.P0``; each MSE (cm²) after the first
-    ``DEFAULT.burn_in_steps`` samples must agree within :data:`MSE_RTOL` relative.
+#: Task 2's function: its parameter, and what a shape error in it (or in my_filter, which
+#: it calls) most likely is.
+_TRIAL_ARGS = ("sigma_v",)
+_TRIAL_SHAPE_HINT = (
+    "Check the shapes of what vision_trial gives my_filter: truth is (n,) and noise is "
+    "(n, 1), so truth + σ_v · noise broadcasts to (n, n); the readings are "
+    "truth[:, None] + σ_v · noise, shape (n, 1). R is 1 × 1: [[σ_v²]].")
+
+
+def _readings(sigma_v: float, scale: float | None = None) -> np.ndarray:
+    """Vision's readings (n, 1) (cm): truth + scale · the scenario's draw (scale = σ_v)."""
+    noise = DEFAULT.unit_noise(sensors=("vision",))
+    return simulation.measure(DEFAULT.truth[:, 0], noise, [sigma_v if scale is None else scale])
+
+
+def _estimates(readings: np.ndarray, r_variance: float) -> np.ndarray:
+    """The engine's estimates (n, 3) of ``readings`` with R = [[r_variance]] (cm²).
+
+    The tasks' vision-only model (:func:`lqe_helpers.experiments.filter_model`) with its
+    R replaced, so that a slip in R (σ for σ², σ⁴) is filtered exactly as written.
+    """
+    vision = experiments.filter_model(DEFAULT)
+    return dataclasses.replace(vision, R=np.array([[r_variance]])).filter(readings).estimates
+
+
+@functools.cache
+def _trial(sigma_v: float) -> dict[str, object]:
+    """Task 2's readings (n, 1) and estimates (n, 3) at ``sigma_v``, and the likely mistakes."""
+    other = SIGMAS_V[1] if sigma_v == SIGMAS_V[0] else SIGMAS_V[0]
+    y = _readings(sigma_v)
+    return {
+        "y": y,
+        "estimates": _estimates(y, sigma_v**2),
+        "y_mistakes": {
+            "the readings were made with σ_v² instead of σ_v (truth + σ_v² · noise)":
+                _readings(sigma_v, sigma_v**2),
+            "the readings were made without σ_v (truth + noise): scale the unit noise by σ_v":
+                _readings(sigma_v, 1.0),
+            f"they are the readings of σ_v = {other:g} cm: scale the noise by the σ_v "
+            f"vision_trial is given": _readings(other),
+            "they are the noise alone (σ_v · noise): add the true position":
+                _readings(sigma_v) - DEFAULT.truth[:, :1],
+        },
+        "estimate_mistakes": {
+            "R holds σ_v (cm) where its variance σ_v² (cm²) belongs, so the filter weighs "
+            "vision wrongly": _estimates(y, sigma_v),
+            "R holds σ_v⁴: the variance σ_v² was squared again": _estimates(y, sigma_v**4),
+            f"R is that of σ_v = {other:g} cm: make R from the σ_v vision_trial is given":
+                _estimates(y, other**2),
+        },
+    }
+
+
+def _trial_output(output: object, name: str, sigma_v: float) -> tuple[object, object]:
+    """The two values ``vision_trial`` returned, or CheckFailed saying what came back."""
+    if isinstance(output, (tuple, list)) and len(output) == 2:
+        return output[0], output[1]
+    found = ("None (nothing): does it end with `return y, estimates`?" if output is None
+             else f"a tuple of {len(output)} items" if isinstance(output, (tuple, list))
+             else f"a {type(output).__name__}")
+    raise CheckFailed(f"{name}({sigma_v:g}) must return two things, the readings y and the "
+                      f"estimates of my_filter (return y, estimates), got {found}")
+
+
+def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndarray]]) -> None:
+    """Check Task 2's ``vision_trial(sigma_v)``: one trial of vision alone, filtered.
+
+    The function is called at σ_v = 1.5 and 4.5 cm (each call given at most
+    :data:`lqe_helpers.student_code.TIME_LIMIT` s) and must return the readings
+    ``truth + σ_v · noise`` of the scenario's draw, shape (n, 1), and the estimates of
+    eq. (5) with ``R = [[σ_v²]]``, ``C = [[1, 0, 0]]``, ``DEFAULT.A``, ``DEFAULT.Q``, z0
+    and ``DEFAULT.P0``, shape (n, 3): both recomputed with the pack's engine before the
+    student's function runs, and equal within :data:`FUNCTION_RTOL` of the largest value.
 
     Parameters
     ----------
-    mse_readings, mse_filtered : dict of float to float
-        The student's MSEs (cm²) keyed by σ_v (cm).
+    vision_trial : callable
+        The student's function of σ_v (cm), returning ``(y, estimates)``.
 
     Raises
     ------
     CheckFailed
-        Naming the entry and the likely cause: σ_v in R where σ_v² belongs, R of the
-        other noise level, the readings' MSE for the estimate's, readings made without
-        σ_v, the whole trial, the burn-in in seconds, the RMSE, ...
+        If the function is not written yet, fails (a shape error names the (n, n) readings
+        of ``truth + σ_v · noise``), does not return two arrays of the right shapes, runs
+        the pack's engine, or computes other numbers; the message names the likely cause:
+        σ_v² or no σ_v in the readings, σ_v or σ_v⁴ in R, the other noise level's R.
     """
-    readings = keyed(mse_readings, "mse_readings", "MSEs (cm²) of the readings")
-    filtered = keyed(mse_filtered, "mse_filtered", "MSEs (cm²) of the estimates")
+    name = require_callable(vision_trial, "vision_trial", "check_vision_trial")
+    n = DEFAULT.n_steps
     for sigma in SIGMAS_V:
-        right = _trial_mses(sigma)
-        other = _trial_mses(right["other"])
-        for label, values, kind in (("mse_readings", readings, "raw"),
-                                    ("mse_filtered", filtered, "filtered")):
-            judge(f"{label}[{sigma:g}]", values[sigma], right[kind], MSE_RTOL, unit="cm²",
-                  what=f"the {'readings' if kind == 'raw' else 'filtered estimate'}' MSE "
-                       f"recomputed from the task's inputs",
-                  mistakes={**right[f"{kind}_mistakes"],
-                            f"it is the value for σ_v = {right['other']:g} cm": other[kind]})
-    passed(f"the MSEs of the readings and of the filtered estimate at σ_v = "
-           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match the pack's engine on the "
-           f"scenario's draw (after the first {DEFAULT.burn_in_steps} samples) to "
-           f"{tolerance_text(MSE_RTOL)} relative")
+        right = _trial(sigma)
+        output = call_student(vision_trial, sigma, name=name, where=f"σ_v = {sigma:g} cm",
+                              arg_names=_TRIAL_ARGS, shape_hint=_TRIAL_SHAPE_HINT,
+                              forbid=(kalman_filter,))
+        y, estimates = _trial_output(output, name, sigma)
+        label = f"the readings y that {name}({sigma:g}) returns"
+        y = student_result(y, name=label, what=f"the readings, an array of shape ({n}, 1)")
+        if y.shape == (n, n):
+            raise CheckFailed(f"{label} have shape ({n}, {n}): {_TRIAL_SHAPE_HINT}")
+        if y.shape == (n,):
+            raise CheckFailed(f"{label} are flat, shape ({n},); keep one column per sensor, "
+                              f"shape ({n}, 1), as my_filter reads one row per time step")
+        judge(label, y, right["y"], FUNCTION_RTOL, unit="cm", mistakes=right["y_mistakes"],
+              what="truth + σ_v · noise on the scenario's draw")
+        label = f"the estimates that {name}({sigma:g}) returns"
+        estimates = student_result(estimates, name=label,
+                                   what=f"the estimates of my_filter, shape ({n}, 3)")
+        if estimates.shape == (n,):
+            raise CheckFailed(f"{label} hold one number per reading (the positions only?); "
+                              f"return all the estimates my_filter gives, shape ({n}, 3)")
+        judge(label, estimates, right["estimates"], FUNCTION_RTOL,
+              mistakes=right["estimate_mistakes"],
+              what="the pack's engine on these readings with R = [[σ_v²]]",
+              hint="my_filter passed its check, so look at what vision_trial gives it: y, "
+                   "A, C = [[1, 0, 0]], Q, R = [[σ_v²]], z0 and P0")
+    passed(f"{name} at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} cm: the readings "
+           f"truth + σ_v · noise and the estimates with R = [[σ_v²]] match the pack's engine "
+           f"on the scenario's draw to {tolerance_text(FUNCTION_RTOL)} of the largest value, "
+           f"{time_limit_text()}")
 
 
 # ------------------------------------------------------------------------------------------
@@ -355,13 +387,20 @@ def check_vision_difference(improvement: dict[float, metrics.Interval]) -> None:
     Raises
     ------
     CheckFailed
-        Naming the entry and the likely cause: the sign reversed, an unpaired interval,
-        the whole trial, the other noise level, a ratio instead of a difference, one
-        MSE alone, the standard deviation for the standard error, ...
+        Naming the entry and the likely cause: a row (one run) taken for a column, the
+        sign reversed, an unpaired interval, the whole trial, the other noise level, a
+        ratio instead of a difference, one MSE alone, the standard deviation for the
+        standard error, ...
     """
     intervals = keyed(improvement, "improvement", "paired intervals (metrics.Interval)")
     runs = _monte_carlo_mses()
     for column, sigma in enumerate(SIGMAS_V):
+        if getattr(intervals[sigma], "runs", None) == len(SIGMAS_V) != DEFAULT.mc_runs:
+            raise CheckFailed(
+                f"improvement[{sigma:g}] is over {len(SIGMAS_V)} values, a row of mse_raw and "
+                f"mse_est (one run at both noise levels): rows and columns are mixed up. Row r "
+                f"is run r, column i is σ_v = {SIGMAS_V[0]:g} or {SIGMAS_V[1]:g} cm: take the "
+                f"column of this σ_v, all {DEFAULT.mc_runs} runs (mse_raw[:, i])")
         raw, filtered = runs["raw"][:, column], runs["filtered"][:, column]
         other = runs["raw"][:, 1 - column] - runs["filtered"][:, 1 - column]
         mistakes = {

@@ -133,7 +133,8 @@ def draw_initial_covariance(figure: Figure, *, p0_variance: float,
     -------
     str
         The numbers of this view, for the line beside the figure: whose filter, P0 and
-        this run's position MSE (cm²) before and after the scenario's burn-in.
+        this run's position MSE (cm²) before and after the scenario's burn-in, to three
+        significant figures.
 
     Raises
     ------
@@ -177,7 +178,7 @@ def _draw(figure: Figure, *, p0_variance: float, scenario: Scenario,
     set_ylim_in_steps(panels.axes[0], low - margin, high + margin, scenario.amplitude / 2)
     who = whose(filter)
     return (f"{who[0].upper()}{who[1:]}, P0 = {p0_variance:.3g} · I. Position MSE of this "
-            f"run: {early_mse:.2f} cm² in the first {scenario.burn_in:g} s, {late_mse:.2f} "
+            f"run: {early_mse:.3g} cm² in the first {scenario.burn_in:g} s, {late_mse:.3g} "
             f"cm² after.")
 
 

@@ -3,7 +3,9 @@
 Every explorer makes its sliders here. A slider refuses a range it could not show
 (empty, infinite), a starting value ipywidgets would clip into the range without a
 word, and a readout it could not read back; :func:`starting_value` refuses a
-scenario value outside a slider's range instead of clipping it.
+scenario value outside a slider's range instead of clipping it. A value set from code
+outside the range (``slider.value = -2``, meant as the exponent of a logarithmic
+slider whose value is P0 itself) raises instead of being clipped to the nearest end.
 """
 
 from __future__ import annotations
@@ -11,8 +13,48 @@ from __future__ import annotations
 import math
 
 import ipywidgets as widgets
+import traitlets
 
 from .. import validation
+
+#: Relative slack at the ends of a range for a value set by the browser, whose sliders
+#: compute the ends (10 ** exponent) in their own floating point.
+_END_SLACK = 1e-9
+
+
+def _in_range(slider: widgets.ValueWidget, value: float, low: float, high: float,
+              hint: str) -> float:
+    """``value`` if it lies in ``[low, high]`` (within :data:`_END_SLACK`), else TraitError.
+
+    ipywidgets clips such a value to the nearest end without a word.
+    """
+    slack = _END_SLACK * max(abs(low), abs(high))
+    if not low - slack <= value <= high + slack:
+        raise traitlets.TraitError(
+            f"the slider {slider.description!r} takes values in [{low:.6g}, {high:.6g}], "
+            f"got {value:.6g}{hint}")
+    return min(max(value, low), high)
+
+
+class _FloatSlider(widgets.FloatSlider):
+    """A FloatSlider that refuses a value outside its range instead of clipping it."""
+
+    @traitlets.validate("value")
+    def _validate_value(self, proposal: traitlets.Bunch) -> float:
+        return _in_range(self, proposal["value"], self.min, self.max, "")
+
+
+class _FloatLogSlider(widgets.FloatLogSlider):
+    """A FloatLogSlider that refuses a value outside its range instead of clipping it.
+
+    Its value is the quantity itself (P0 in cm²), not the exponent the slider moves.
+    """
+
+    @traitlets.validate("value")
+    def _validate_value(self, proposal: traitlets.Bunch) -> float:
+        return _in_range(self, proposal["value"], self.base ** self.min, self.base ** self.max,
+                         f": the value itself, not its exponent (1e-2 for "
+                         f"{self.base:g}^-2)")
 
 
 def _check_readout_format(readout_format: str) -> None:
@@ -74,11 +116,13 @@ def float_slider(description: str, value: float, low: float, high: float, step: 
     ValueError
         If a number is not finite, the range is empty, ``step <= 0``, ``value`` lies
         outside ``[low, high]`` or the readout could not be read back.
+    traitlets.TraitError
+        Later, if code sets the slider's value outside ``[low, high]``.
     """
     _check_readout_format(readout_format)
     value, low, high = _check_range(description, value, low, high)
     step = validation.positive("step", step)
-    return widgets.FloatSlider(
+    return _FloatSlider(
         value=value, min=low, max=high, step=step, description=description,
         readout_format=readout_format, continuous_update=False,
         style={"description_width": "initial"}, layout=widgets.Layout(width="340px"),
@@ -108,6 +152,8 @@ def log_slider(description: str, value: float, low: float, high: float,
         If a number is not finite, ``low <= 0``, the range is empty, ``value`` lies
         outside ``[low, high]``, ``steps_per_decade`` is not a whole number >= 1 or
         the readout could not be read back.
+    traitlets.TraitError
+        Later, if code sets the slider's value outside ``[low, high]`` (an exponent, say).
     """
     _check_readout_format(readout_format)
     value, low, high = _check_range(description, value, low, high)
@@ -116,7 +162,7 @@ def log_slider(description: str, value: float, low: float, high: float,
             f"low must be > 0 for the logarithmic slider {description!r}, got {low:.12g}"
         )
     steps_per_decade = validation.count("steps_per_decade", steps_per_decade, minimum=1)
-    return widgets.FloatLogSlider(
+    return _FloatLogSlider(
         value=value, base=10, min=math.log10(low), max=math.log10(high),
         step=1.0 / steps_per_decade, description=description, readout_format=readout_format,
         continuous_update=False, style={"description_width": "initial"},

@@ -107,8 +107,9 @@ def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,
     -------
     str
         The numbers of this view, for the line beside the figure: σ_v, whose filter
-        made the estimate, and this run's mean squared error (cm²) of the raw vision
-        and of the filtered estimate after the scenario's burn-in.
+        made the estimate, this run's mean squared error (cm²) of the raw vision and of
+        the filtered estimate after the scenario's burn-in, and their ratio, each to
+        three significant figures (readable from σ_v = 0.1 to 10 cm).
 
     Raises
     ------
@@ -142,9 +143,10 @@ def _draw(figure: Figure, *, sigma_v: float, scenario: Scenario,
     margin = 0.05 * (high - low)
     # In steps of half the amplitude: most slider moves keep the axis as it was.
     set_ylim_in_steps(panel.ax, low - margin, high + margin, scenario.amplitude / 2)
+    ratio = f"{raw_mse / filtered_mse:.3g}" if filtered_mse > 0 else "undefined"
     return (f"σ_v = {sigma_v:.1f} cm, filtered by {whose(filter)}. MSE of this run after "
-            f"{scenario.burn_in:g} s: raw vision {raw_mse:.2f} cm², filtered "
-            f"{filtered_mse:.2f} cm².")
+            f"{scenario.burn_in:g} s: raw vision {raw_mse:.3g} cm², filtered "
+            f"{filtered_mse:.3g} cm², ratio raw / filtered {ratio}.")
 
 
 def describe_vision(*, sigma_v: float, scenario: Scenario = DEFAULT,

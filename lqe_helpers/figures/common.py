@@ -5,9 +5,10 @@ below; notebooks 01, 03, 04, 05) and :func:`paired_mse_figure` (one point per Mo
 Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 (:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
-:func:`mean_band`), values marked by a labelled vertical line (:func:`mark_values`),
-plain tick labels on a log axis (:func:`plain_log_ticks`) and the first seconds of a
-trial (:func:`first_seconds`). Nothing runs on import.
+:func:`mean_band`), values marked by a labelled vertical line (:func:`mark_values`), a
+legend above a full panel (:func:`legend_above`), plain tick labels on a log axis
+(:func:`plain_log_ticks`) and the first seconds of a trial (:func:`first_seconds`).
+Nothing runs on import.
 """
 
 from __future__ import annotations
@@ -158,6 +159,19 @@ def plain_log_ticks(ax: Axes, axis: str, ticks: Sequence[float] | None) -> None:
         ax.yaxis.set_minor_locator(plt.NullLocator())
 
 
+def legend_above(ax: Axes, title: str = "") -> None:
+    """Put ``ax``'s legend in one row above the panel, between it and its ``title``.
+
+    For panels whose data fill them from edge to edge (readings and estimates over a
+    whole trial), where a legend inside would cover some of them.
+    """
+    labels = ax.get_legend_handles_labels()[1]
+    ax.legend(loc="lower center", bbox_to_anchor=(0.5, 1.0), ncol=max(len(labels), 1),
+              frameon=False, fontsize=9, markerscale=2.5, handlelength=1.8,
+              columnspacing=1.2, borderaxespad=0.2)
+    ax.set_title(title, pad=22)
+
+
 def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
                                estimates: dict[str, tuple[np.ndarray, str]],
                                readings: dict[str, tuple[np.ndarray, str]] | None = None,
@@ -182,7 +196,8 @@ def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
     Returns
     -------
     Figure
-        Two panels sharing the time axis; lines in the order readings, truth, estimates.
+        Two panels sharing the time axis; lines in the order readings, truth, estimates;
+        the legend in one row above the top panel, under its title, clear of the data.
     """
     times = np.asarray(times, dtype=float)
     truth = np.asarray(truth, dtype=float)
@@ -196,8 +211,8 @@ def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
         values = np.asarray(values, dtype=float)
         ax_top.plot(times, values, **style(role, label=label))
         ax_err.plot(times, values - truth, **style(role, linewidth=1.1, label=label))
-    label_axes(ax_top, ylabel="position (cm)", title=title,
-               legend={"loc": "upper right", "fontsize": 9, "ncol": 2, "markerscale": 2.5})
+    label_axes(ax_top, ylabel="position (cm)")
+    legend_above(ax_top, title)
     label_axes(ax_err, "time (s)", "error (cm)", xlim=(times[0], times[-1]))
     fig.tight_layout()
     return fig

@@ -11,7 +11,6 @@ from collections.abc import Mapping
 
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from ..plotting import COLORS, style
@@ -60,23 +59,7 @@ def fusion_trial_figure(times: np.ndarray, truth: np.ndarray, vision_only: np.nd
         shown = {"vision readings": (readings[:, 0], "vision"),
                  "proprioception readings": (readings[:, 1], "proprioception")}
     estimates = {"vision only": (vision_only, "alternative"), fused_label: (fused, "estimate")}
-    fig = tracking_comparison_figure(times, truth, estimates, readings=shown, title=title)
-    _legend_above(fig.axes[0])
-    return fig
-
-
-def _legend_above(ax: Axes) -> None:
-    """Move ``ax``'s legend out of the data: one row above the panel, under its title.
-
-    The readings and estimates fill the panel from edge to edge, so a legend inside it
-    covers some of them.
-    """
-    handles, labels = ax.get_legend_handles_labels()
-    ax.legend(handles, labels, loc="lower center", bbox_to_anchor=(0.5, 1.0),
-              ncol=len(labels), frameon=False, fontsize=9, markerscale=2.5,
-              handlelength=1.8, columnspacing=1.2, borderaxespad=0.2)
-    ax.set_title(ax.get_title(), pad=22)
-    ax.figure.tight_layout()
+    return tracking_comparison_figure(times, truth, estimates, readings=shown, title=title)
 
 
 #: A curve of :func:`frequency_response_figure`: (gain |H|, shape (f,); lead in s, shape

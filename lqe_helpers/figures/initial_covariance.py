@@ -7,7 +7,14 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from ..plotting import COLORS, style
-from .common import errorbar_intervals, first_seconds, label_axes, mark_values, plot_series
+from .common import (
+    errorbar_intervals,
+    first_seconds,
+    label_axes,
+    legend_above,
+    mark_values,
+    plot_series,
+)
 
 
 def start_up_figure(times: np.ndarray, truth: np.ndarray,
@@ -31,7 +38,7 @@ def start_up_figure(times: np.ndarray, truth: np.ndarray,
     Returns
     -------
     Figure
-        Two panels sharing the time axis.
+        Two panels sharing the time axis; the legend above the position panel.
     """
     times, shown = first_seconds(times, until)
     truth = np.asarray(truth, dtype=float)
@@ -42,8 +49,8 @@ def start_up_figure(times: np.ndarray, truth: np.ndarray,
         plot_series(ax, times, [(truth[:, column], "truth", "truth")]
                     + [(np.asarray(states, dtype=float)[:, column], role, label)
                        for label, (states, role) in estimates.items()], shown)
-    label_axes(ax_p, ylabel="position (cm)", title="Position",
-               legend={"loc": "upper right", "fontsize": 9, "ncol": 2, "markerscale": 2.5})
+    label_axes(ax_p, ylabel="position (cm)")
+    legend_above(ax_p, "Position")
     label_axes(ax_v, "time (s)", "velocity (cm/s)", "Velocity", xlim=(0.0, until))
     fig.tight_layout()
     return fig

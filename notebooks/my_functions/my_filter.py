@@ -4,7 +4,9 @@ import numpy as np
 
 
 def my_filter(y, A, C, Q, R, z0, P0):
-    """The Linear Quadratic Estimator of Tutorial eq. (5); returns the estimates (n, k)."""
+    """Tutorial eq. (5). From ẑ = z0 and P = P0, for each reading y_j in turn:
+    K = P Cᵀ (C P Cᵀ + R)⁻¹, then ẑ ← A ẑ + K (y_j − C A ẑ), then P ← A (P − K C P) Aᵀ + Q;
+    keep each ẑ. Returns the estimates, shape (n, k)."""
     z = z0
     P = P0
     estimates = []
