@@ -180,6 +180,7 @@ def close_to(estimates: np.ndarray, expected: np.ndarray) -> None:
 @pytest.mark.parametrize(("bias", "sigma_a", "sigma_v"),
                          [(20.0, 20.0, 1.5), (-55.0, 300.0, 4.5), (0.0, 1.0, 0.5),
                           (60.0, 1000.0, 6.0)])
+@pytest.mark.slow
 def test_unbiased_run_at_a_bias_is_the_filter_fed_that_biased_signal(bias, sigma_a,
                                                                      sigma_v) -> None:
     """The linear-in-bias shortcut, against the filter run on the biased signal, to 1e-9."""
@@ -212,6 +213,7 @@ def test_unit_response_is_the_filter_of_a_constant_unit_input_alone() -> None:
         run.at_bias(float("inf"))
 
 
+@pytest.mark.slow
 def test_dead_reckoning_spread_matches_monte_carlo_and_power_law() -> None:
     sigma_a = 20.0
     spread = bias_model.dead_reckoning_spread(DEFAULT, sigma_a)

@@ -127,6 +127,7 @@ def sweep(mistake=""):
     return grid, runs, np.array(systematic), noise_part, np.array(expected)
 
 
+@pytest.mark.slow
 def test_check_jerk_sweep_passes_the_worked_solution(capsys):
     assert_passes(capsys, checks.check_jerk_sweep, *sweep()[1:])
 
@@ -136,6 +137,7 @@ def test_check_jerk_sweep_passes_the_worked_solution(capsys):
     ("prediction", "it is the prediction's variance"),
     ("difference", "it is the mean MSE minus the systematic MSE"),
 ])
+@pytest.mark.slow
 def test_check_jerk_sweep_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_jerk_sweep, *sweep(mistake)[1:])
 
@@ -244,6 +246,7 @@ def from_readings(*, mistake=""):
     return nis_mean, chosen
 
 
+@pytest.mark.slow
 def test_check_jerk_from_readings_passes_the_worked_solution(capsys):
     line = assert_passes(capsys, checks.check_jerk_from_readings, *from_readings())
     assert "300 runs" in line
@@ -255,6 +258,7 @@ def test_check_jerk_from_readings_passes_the_worked_solution(capsys):
     ("R only", "the sensor's variance σ_v² alone"),
     ("swapped", "it is the σ_j chosen by MSE, not by likelihood"),
 ])
+@pytest.mark.slow
 def test_check_jerk_from_readings_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_jerk_from_readings, *from_readings(mistake=mistake))
 

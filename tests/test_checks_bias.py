@@ -124,6 +124,7 @@ def test_the_signal_helps_so_the_improvement_is_positive():
     ("mean vision", "one side is the mean MSE over the runs"),
     ("mean signal", "the other the mean MSE over the runs"),
 ])
+@pytest.mark.slow
 def test_check_signal_worth_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_signal_worth, signal_worth(mistake=mistake))
 

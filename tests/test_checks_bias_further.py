@@ -131,6 +131,7 @@ def sigma_a_sweep(mistake=""):
     return sweep_mse, sweep_paired, sweep_rms, sweep_std
 
 
+@pytest.mark.slow
 def test_check_sigma_a_sweep_passes_the_worked_solution(capsys):
     assert_passes(capsys, checks.check_sigma_a_sweep, *sigma_a_sweep())
 
@@ -141,6 +142,7 @@ def test_check_sigma_a_sweep_passes_the_worked_solution(capsys):
     ("variance", "it is the variance of b̂"),
     ("swapped", "it is the filter's own σ of b̂, not the RMS error"),
 ])
+@pytest.mark.slow
 def test_check_sigma_a_sweep_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_sigma_a_sweep, *sigma_a_sweep(mistake))
 
@@ -176,6 +178,7 @@ def bias_and_vision(mistake=""):
     return change_by_bias, gain_by_sigma_v
 
 
+@pytest.mark.slow
 def test_check_bias_and_vision_passes_the_worked_solution(capsys):
     assert_passes(capsys, checks.check_bias_and_vision, *bias_and_vision())
 
@@ -187,5 +190,6 @@ def test_check_bias_and_vision_passes_the_worked_solution(capsys):
     ("wrong base", "in % of the MSE with the signal"),
     ("reversed", "the sign is reversed: with the signal − vision only"),
 ])
+@pytest.mark.slow
 def test_check_bias_and_vision_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_bias_and_vision, *bias_and_vision(mistake))

@@ -371,6 +371,7 @@ def test_check_delay_difference_passes_the_worked_answer(capsys) -> None:
     ("compensated over delayed", "won_back is not right: it is compensated / delayed"),
     ("names swapped", "gain is not right: it is the share of the delay's cost won back"),
 ])
+@pytest.mark.slow
 def test_check_delay_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_delay_difference, *task3(slip))
 

@@ -88,6 +88,7 @@ def test_check_late_eye_passes_the_worked_answer(capsys) -> None:
     ("circular noise part", "it is taken from the delayed MSEs, which makes the comparison "
                             "circular"),
 ])
+@pytest.mark.slow
 def test_check_late_eye_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_late_eye, *late_eye_task(slip))
 
@@ -128,6 +129,7 @@ def worked_sweep() -> tuple[np.ndarray, dict[str, np.ndarray]]:
     return sweep_task()
 
 
+@pytest.mark.slow
 def test_check_delay_sweep_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_delay_sweep, *worked_sweep())
     assert "(51 delays × 300 runs)" in line
@@ -145,6 +147,7 @@ def test_check_delay_sweep_passes_the_worked_answer(capsys) -> None:
     ("other keys", "sweep_mse must be a dict with the keys \"delayed\" and \"predicted\", got "
                    "keys ['compensated', 'delayed']"),
 ])
+@pytest.mark.slow
 def test_check_delay_sweep_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_delay_sweep, *sweep_task(slip))
 
@@ -217,6 +220,7 @@ def regimes_task(slip: str = "") -> tuple[float, float, float]:
     return help_from, help_to, best_delay
 
 
+@pytest.mark.slow
 def test_check_compensation_regimes_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_compensation_regimes, *regimes_task())
     assert "paired 95 % interval above zero" in line
@@ -322,6 +326,7 @@ def test_check_short_delays_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_short_delays, *short_task(slip))
 
 
+@pytest.mark.slow
 def test_the_going_further_checks_judge_against_another_draw() -> None:
     """Numbers from the same code on another noise draw agree with each other, not the task."""
     import dataclasses

@@ -137,6 +137,7 @@ def test_check_fusion_trial_passes_the_worked_solution(capsys) -> None:
     ("fused MSE twice", "mse_vision_trial = 0.15961 cm² is not right: it is the MSE of the "
                         "fused filter's estimate"),
 ])
+@pytest.mark.slow
 def test_check_fusion_trial_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_fusion_trial, *task2(mistake))
 
@@ -216,6 +217,7 @@ def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
     ("burn-in in seconds", "mse_vision is not right: it leaves out the first 1 sample(s)"),
     ("swapped", "mse_vision is not right: these are the fused filter's MSEs"),
 ])
+@pytest.mark.slow
 def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_fusion_difference, *task3(mistake))
 

@@ -64,6 +64,7 @@ def test_check_noise_free_fits_passes_the_worked_solution(capsys) -> None:
     ("rad/s", "the frequency was given in rad/s (2π f)"),
     ("swapped", "it is the fit of the fused filter: the keys are swapped"),
 ])
+@pytest.mark.slow
 def test_check_noise_free_fits_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_noise_free_fits, fits_answer(mistake))
 
@@ -164,6 +165,7 @@ def test_check_equivalent_sensor_passes_and_its_positions_are_the_fused_filters(
     ("sum", "the filter read the sum of the two readings, not their average"),
     ("vision column", "the filter read vision's readings alone (column 0), not the average"),
 ])
+@pytest.mark.slow
 def test_check_equivalent_sensor_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_equivalent_sensor, *equivalent_answer(mistake))
 

@@ -355,6 +355,7 @@ def test_check_overconfidence_names_each_typical_mistake(batch, squared) -> None
 # ------------------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_check_convergence_intervals_passes_with_any_seed(capsys, squared) -> None:
     for seed in (DEFAULT.seed, 1, 2026):
         rng = np.random.default_rng(seed)
@@ -403,6 +404,7 @@ def sweep() -> dict[str, np.ndarray]:
                                for curve in squared_sweep.mean(axis=0)])}
 
 
+@pytest.mark.slow
 def test_check_p0_sweep_passes_the_worked_solution(capsys, sweep) -> None:
     line = assert_passes(capsys, checks.check_p0_sweep, sweep["start"], sweep["after"],
                          sweep["times"])
@@ -410,6 +412,7 @@ def test_check_p0_sweep_passes_the_worked_solution(capsys, sweep) -> None:
            "1000, 100000, 1e+06" in line
 
 
+@pytest.mark.slow
 def test_check_p0_sweep_names_each_typical_mistake(sweep) -> None:
     start, after, times = sweep["start"], sweep["after"], sweep["times"]
     whole = metrics.mse(sweep["positions"], TRUTH[:, 0])

@@ -137,6 +137,7 @@ def test_check_noisier_trial_passes_the_worked_answer(capsys) -> None:
     ("rmse", "mse_fused_trial = 0.5233"),
     ("rmse", "it is the root mean squared error (RMSE, in cm)"),
 ])
+@pytest.mark.slow
 def test_check_noisier_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_noisier_trial, *task2(slip))
 
@@ -213,6 +214,7 @@ def task3(slip: str = ""):
     return mse_vision, mse_fused, difference
 
 
+@pytest.mark.slow
 def test_check_noisier_difference_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_noisier_difference, *task3())
     assert "the paired difference vision-only − fused after the first second over 300 runs" in line
@@ -231,6 +233,7 @@ def test_check_noisier_difference_passes_the_worked_answer(capsys) -> None:
     ("mean MSEs", "mse_vision is one number; the task asks for one MSE per run, shape (300,)"),
     ("swapped", "mse_vision is not right: these are the fused filter's MSEs"),
 ])
+@pytest.mark.slow
 def test_check_noisier_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_noisier_difference, *task3(slip))
 
@@ -241,6 +244,7 @@ def test_check_noisier_difference_names_the_whole_trial_for_both_filters() -> No
     assert "Also, mse_fused is not right: these are over the whole trial" in message
 
 
+@pytest.mark.slow
 def test_check_noisier_difference_is_instant() -> None:
     """Its first call runs the engine on five settings (its own and three mistakes')."""
     from lqe_helpers.checks import noisier_proprioception
@@ -331,6 +335,7 @@ def task_sweep(sweep_mse, slip: str = ""):
     return SWEEP_SIGMA_P, margins, DENSE_SIGMA_P, theory_margin
 
 
+@pytest.mark.slow
 def test_check_proprioception_sweep_passes_the_worked_answer(capsys, sweep_mse) -> None:
     line = assert_passes(capsys, checks.check_proprioception_sweep, *task_sweep(sweep_mse))
     assert "at σ_p = 0.3, 1.5 and 4.5 cm" in line
@@ -343,6 +348,7 @@ def test_check_proprioception_sweep_passes_the_worked_answer(capsys, sweep_mse) 
     ("variances", "theory_margin is not right: the variances σ² went where"),
     ("theory fraction", "theory_margin is not right: it is a fraction"),
 ])
+@pytest.mark.slow
 def test_check_proprioception_sweep_names_the_cause(sweep_mse, slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_proprioception_sweep, *task_sweep(sweep_mse, slip))
 
@@ -424,6 +430,7 @@ def task_excess(misjudged, slip: str = "") -> dict:
     return excess
 
 
+@pytest.mark.slow
 def test_check_misjudged_passes_the_worked_answer(capsys, misjudged) -> None:
     assert_passes(capsys, checks.check_misjudged, task_excess(misjudged))
 
@@ -458,6 +465,7 @@ def task_nis(misjudged, slip: str = "") -> tuple[dict, dict]:
     return nis, inside
 
 
+@pytest.mark.slow
 def test_check_misjudged_nis_passes_the_worked_answer(capsys, misjudged) -> None:
     assert_passes(capsys, checks.check_misjudged_nis, *task_nis(misjudged))
 
@@ -485,6 +493,7 @@ def test_the_worked_nis_shows_both_views(misjudged) -> None:
     ("one sensor", "it uses the band of one sensor"),
     ("fraction", "inside['correct'] = 0.946667 % is not right: it is a fraction"),
 ])
+@pytest.mark.slow
 def test_check_misjudged_nis_names_the_cause(misjudged, slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_misjudged_nis, *task_nis(misjudged, slip))
 
@@ -510,6 +519,7 @@ def task_assumed_sweep(slip: str = ""):
     return ASSUMED_GRID, [metrics.mean_ci95(c - against) for c in columns]
 
 
+@pytest.mark.slow
 def test_check_assumed_sweep_passes_the_worked_answer(capsys) -> None:
     line = assert_passes(capsys, checks.check_assumed_sweep, *task_assumed_sweep())
     assert "at σ̃_p = 0.5, 1.5, 40.5 cm" in line
@@ -520,10 +530,12 @@ def test_check_assumed_sweep_passes_the_worked_answer(capsys) -> None:
     ("over vision", "excess_ci[0] is not right: it is the excess over vision alone"),
     ("swapped sigmas", "true and assumed σ_p are swapped (readings made with 0.5 cm)"),
 ])
+@pytest.mark.slow
 def test_check_assumed_sweep_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_assumed_sweep, *task_assumed_sweep(slip))
 
 
+@pytest.mark.slow
 def test_check_assumed_sweep_never_judges_the_true_sigma() -> None:
     """At σ̃_p = 4.5 cm the excess is zero up to round-off, which no tolerance can judge."""
     grid = np.array([2.0, 4.5, 6.0, 9.0])

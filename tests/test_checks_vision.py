@@ -435,6 +435,7 @@ def test_check_vision_difference_passes_the_worked_answer(capsys) -> None:
     ("rows", "improvement[1.5] is over 2 values, a row of mse_raw and mse_est (one run at both "
              "noise levels): rows and columns are mixed up"),
 ])
+@pytest.mark.slow
 def test_check_vision_difference_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_difference, task3(slip))
 

@@ -185,6 +185,7 @@ def comparison(batch, slip: str = "") -> tuple[dict, dict, np.ndarray]:
     return best_alpha, smoother_vs_lqe, ALPHAS
 
 
+@pytest.mark.slow
 def test_check_smoother_comparison_passes_the_worked_answer(batch, capsys) -> None:
     line = assert_passes(capsys, checks.check_smoother_comparison, *comparison(batch))
     assert "paired difference smoother − LQE over 300 runs" in line
@@ -198,10 +199,12 @@ def test_check_smoother_comparison_passes_the_worked_answer(batch, capsys) -> No
     ("reversed", "smoother_vs_lqe[1.5] is not right: the sign is reversed"),
     ("unpaired", "it combines the two separate intervals"),
 ])
+@pytest.mark.slow
 def test_check_smoother_comparison_names_the_cause(batch, slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_smoother_comparison, *comparison(batch, slip))
 
 
+@pytest.mark.slow
 def test_check_smoother_comparison_follows_the_grid_and_refuses_a_bad_one(batch) -> None:
     best_alpha, smoother_vs_lqe, _ = comparison(batch)
     # The right answer for one grid is wrong for another: the grid is the task's input.
@@ -373,6 +376,7 @@ def sampling(slip: str = "") -> dict:
     return ratio
 
 
+@pytest.mark.slow
 def test_check_sampling_ratio_passes_the_worked_answer(capsys) -> None:
     assert_passes(capsys, checks.check_sampling_ratio, sampling())
 
@@ -385,10 +389,12 @@ def test_check_sampling_ratio_passes_the_worked_answer(capsys) -> None:
     ("burn in samples", "it leaves out 100 samples at every Δt"),
     ("mean of ratios", "it is the mean of the per-run ratios"),
 ])
+@pytest.mark.slow
 def test_check_sampling_ratio_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_sampling_ratio, sampling(slip))
 
 
+@pytest.mark.slow
 def test_check_sampling_ratio_wants_the_three_time_steps() -> None:
     ratio = sampling()
     assert_fails("ratio has no entry for Δt = 0.002 s", checks.check_sampling_ratio,

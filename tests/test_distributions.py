@@ -31,6 +31,7 @@ def test_chi2_quantile_refuses_what_is_not_a_probability_or_df(args, message: st
 
 
 @pytest.mark.parametrize("probability", [1e-6, 0.025, 0.975])
+@pytest.mark.slow
 def test_chi2_quantile_for_ten_million_degrees_of_freedom(probability: float) -> None:
     # scipy's ppf is 0.8 % off in the far tail here; the reference is P(df/2, x/2) summed
     # as its series in 30-digit arithmetic.

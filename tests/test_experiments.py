@@ -229,6 +229,7 @@ def test_tracking_figure_draws_this_run_its_readings_and_the_runs_compared() -> 
         plt.close(fig)
 
 
+@pytest.mark.slow
 def test_tracking_figure_equals_the_figure_drawn_from_its_arrays() -> None:
     """What notebook 01 draws today from six arrays, from the one object."""
     import matplotlib.pyplot as plt
@@ -250,6 +251,7 @@ def test_tracking_figure_equals_the_figure_drawn_from_its_arrays() -> None:
         plt.close(by_object)
 
 
+@pytest.mark.slow
 def test_delayed_tracking_figure_equals_the_figure_drawn_from_its_arrays() -> None:
     """Notebook 05's Figure 1: ``delayed.figure()`` instead of six arrays."""
     import matplotlib.pyplot as plt

@@ -49,6 +49,7 @@ def draw_line_with_numbers(figure, *, slope):
     return f"rise over one unit: {slope:g} cm <ok>"
 
 
+@pytest.mark.slow
 def test_the_numbers_of_a_view_go_beside_the_figure_and_into_the_static_caption():
     explorer = Explorer("a test line", {"slope": float_slider("s (cm)", 1.0, 0.0, 5.0, 0.5)},
                         draw_line_with_numbers, figsize=(4.0, 3.0), dpi=50)
@@ -306,6 +307,7 @@ def test_artists_added_after_building_do_not_force_a_rebuild():
     assert len(build.calls) == 1
 
 
+@pytest.mark.slow
 def test_built_panels_do_not_keep_their_figure_alive():
     figure = Figure()
     reuse_panels(figure, CountingBuild(), "key")
@@ -364,6 +366,7 @@ DRAWINGS = [
 
 
 @pytest.mark.parametrize(("module", "name", "values"), DRAWINGS, ids=[d[0] for d in DRAWINGS])
+@pytest.mark.slow
 def test_every_explorer_keeps_its_panels_until_the_scenario_changes(module, name, values):
     draw = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), name)
     figure = Figure(figsize=(10.0, 5.0))
@@ -428,6 +431,7 @@ def _full_rendering(explorer: Explorer) -> np.ndarray:
 
 @pytest.mark.parametrize(("module", "factory", "name"), _slider_cases(),
                          ids=[f"{m}-{n}" for m, _, n in _slider_cases()])
+@pytest.mark.slow
 def test_fast_redraw_equals_a_fresh_full_drawing(module, factory, name):
     explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
     slider = explorer.sliders[name]
@@ -443,6 +447,7 @@ def test_fast_redraw_equals_a_fresh_full_drawing(module, factory, name):
                                                explorer.layers.fast_renders)
 
 
+@pytest.mark.slow
 def test_fast_path_repaints_only_changed_artists_and_detects_other_changes():
     explorer = make_explorer()
     explorer.sliders["slope"].value = 2.0  # builds the cached layer
@@ -486,6 +491,7 @@ def _marker_and_legend() -> tuple[Figure, Line2D, Legend]:
     return figure, marker, legend
 
 
+@pytest.mark.slow
 def test_a_marker_is_repainted_with_what_covers_it_only_where_it_is():
     """A clipped line's extent is where its points and markers are, not its whole axes."""
     figure, marker, legend = _marker_and_legend()
@@ -515,6 +521,7 @@ def test_png_encoding_keeps_every_pixel():
 
 
 @pytest.mark.parametrize(("module", "factory"), FACTORIES, ids=[f[0] for f in FACTORIES])
+@pytest.mark.slow
 def test_static_picture_describes_the_current_view(module, factory):
     explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
     description = explorer.description

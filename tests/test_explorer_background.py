@@ -61,6 +61,7 @@ def test_slider_follows_the_conventions(explorer) -> None:
 
 
 @pytest.mark.parametrize("jerk_std", [10.0, 100.0, 30000.0, 1.0e5])
+@pytest.mark.slow
 def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: float) -> None:
     previous_png = explorer.png
     explorer.sliders["jerk_std"].value = jerk_std
@@ -92,10 +93,12 @@ def test_moving_the_slider_redraws_the_direct_computation(explorer, jerk_std: fl
     assert explorer.png != previous_png
 
 
+@pytest.mark.slow
 def test_no_text_in_the_figure_changes_with_the_slider(explorer) -> None:
     assert_only_numbers_change(explorer, "jerk_std", 10.0)
 
 
+@pytest.mark.slow
 def test_numbers_give_when_the_uncertainty_reaches_the_amplitude(explorer) -> None:
     reaches = ("2σ of the predicted position reaches the flight's amplitude of "
                f"{DEFAULT.amplitude:g} cm")
@@ -111,6 +114,7 @@ def test_numbers_give_when_the_uncertainty_reaches_the_amplitude(explorer) -> No
     assert f"{reaches} after more than {background.OPEN_LOOP_DURATION:g} s. " in explorer.numbers
 
 
+@pytest.mark.slow
 def test_lag_and_noise_show_in_the_tracking_error(explorer) -> None:
     """Too small σ_j: large, overconfident error; matched σ_j: much smaller."""
     mses = {}
@@ -122,6 +126,7 @@ def test_lag_and_noise_show_in_the_tracking_error(explorer) -> None:
     assert mses[DEFAULT.process_jerk_std] < mses[1.0e5] < mses[10.0]
 
 
+@pytest.mark.slow
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
     estimates, visions = [], []
     for jerk_std in (300.0, 3000.0, 300.0):
@@ -161,6 +166,7 @@ def test_bad_jerk_std_is_rejected_by_name(bad: float) -> None:
         background.draw_background(Figure(), jerk_std=bad)
 
 
+@pytest.mark.slow
 def test_static_display_carries_the_picture(explorer) -> None:
     bundle = explorer._repr_mimebundle_()
     assert bundle["text/plain"].startswith("Interactive explorer")
@@ -170,6 +176,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
+@pytest.mark.slow
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(10, 4.2))
     for jerk_std in (10.0, 1.0e5, DEFAULT.process_jerk_std):
@@ -210,6 +217,7 @@ def test_another_scenario_redraws_its_reference_curve() -> None:
 
 
 @pytest.mark.parametrize("jerk_std", [5.0, 300.0, 2.0e5])
+@pytest.mark.slow
 def test_the_scenarios_jerk_std_is_the_reference_whatever_its_value(jerk_std: float) -> None:
     """The slider starts at START_JERK_STD for any scenario; the scenario's σ_j, even one
     outside the slider's range, is the reference curve, and the noise is the explorer's."""

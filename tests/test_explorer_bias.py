@@ -108,6 +108,7 @@ def test_sliders_follow_the_conventions(explorer) -> None:
 
 @pytest.mark.parametrize(("name", "value"),
                          [("bias", -55.0), ("sigma_a", 300.0), ("sigma_v", 4.5), ("bias", 0.0)])
+@pytest.mark.slow
 def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
                                                         value: float) -> None:
     previous_png = explorer.png
@@ -140,6 +141,7 @@ def test_moving_a_slider_redraws_the_direct_computation(explorer, name: str,
     assert explorer.png != previous_png
 
 
+@pytest.mark.slow
 def test_the_numbers_go_beside_the_figure_and_its_text_stays_put(explorer) -> None:
     """Text is the costliest thing to repaint: a move changes the line, not the figure's text."""
     before, numbers = texts(explorer.figure), explorer.numbers
@@ -156,6 +158,7 @@ def test_the_numbers_go_beside_the_figure_and_its_text_stays_put(explorer) -> No
     assert html.escape(explorer.numbers) in explorer._repr_mimebundle_()["text/html"]
 
 
+@pytest.mark.slow
 def test_a_move_recomputes_only_what_its_slider_changes(explorer) -> None:
     """The filter run hangs on (σ_a, σ_v) only, since a move of b only shifts it; the
     run of the last (σ_a, σ_v) is kept, so a σ moved back to an earlier value pays again."""
@@ -183,6 +186,7 @@ def test_a_move_recomputes_only_what_its_slider_changes(explorer) -> None:
         check_numbers(explorer.numbers, values, noise)
 
 
+@pytest.mark.slow
 def test_noise_pattern_stays_fixed_across_slider_moves(explorer) -> None:
     explorer.sliders["bias"].value = 20.0
     truth = DEFAULT.truth[SHOWN, 0]
@@ -258,6 +262,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert explorer.png.startswith(b"\x89PNG")
 
 
+@pytest.mark.slow
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(10, 4.6))
     for values in ({"bias": -55.0, "sigma_a": 300.0, "sigma_v": 4.5},

@@ -137,6 +137,7 @@ def test_initial_figure_is_the_question_delay():
 
 
 @pytest.mark.parametrize("delay", [0.0, 0.01, 0.25, MAX_DELAY])
+@pytest.mark.slow
 def test_slider_value_redraws_the_direct_computation(delay):
     explorer = explore_delay()
     before = explorer.png
@@ -146,6 +147,7 @@ def test_slider_value_redraws_the_direct_computation(delay):
     assert explorer.png != before
 
 
+@pytest.mark.slow
 def test_noise_stays_fixed_across_slider_moves():
     explorer = explore_delay()
     explorer.sliders["delay"].value = 0.05
@@ -159,6 +161,7 @@ def test_noise_stays_fixed_across_slider_moves():
     np.testing.assert_array_equal(_lines(explorer.figure)["vision"], first)
 
 
+@pytest.mark.slow
 def test_slider_value_between_steps_is_rounded_to_a_step():
     explorer = explore_delay()
     explorer.sliders["delay"].value = 0.1240000001
@@ -166,6 +169,7 @@ def test_slider_value_between_steps_is_rounded_to_a_step():
                   EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
 
 
+@pytest.mark.slow
 def test_redraw_reuses_axes_and_keeps_one_band():
     explorer = explore_delay()
     axes = list(explorer.figure.axes)
@@ -177,6 +181,7 @@ def test_redraw_reuses_axes_and_keeps_one_band():
                   EXPLORER_SCENARIO.unit_noise(sensors=("vision",)))
 
 
+@pytest.mark.slow
 def test_slider_moves_change_the_numbers_line_not_the_figure_text():
     """Text is the costliest thing to repaint: a move changes only the line beside the figure."""
     explorer = explore_delay()
@@ -235,6 +240,7 @@ def test_explorer_follows_its_scenario():
     _check_figure(explorer.figure, explorer.numbers, 0.2, noise, sigma_v=4.5)
 
 
+@pytest.mark.slow
 def test_slider_range_stops_before_the_end_of_a_short_trial():
     scenario = dataclasses.replace(DEFAULT, duration=0.3, burn_in=0.1, delay=0.1)
     slider = explore_delay(scenario).sliders["delay"]
@@ -279,6 +285,7 @@ def compensate(estimates, A, delay_steps):
 
 
 @pytest.mark.parametrize("delay", [0.1, 0.0, 0.37])
+@pytest.mark.slow
 def test_the_students_functions_draw_what_the_engine_draws(delay):
     calls = {"filter": 0, "compensate": 0}
 
@@ -389,6 +396,7 @@ def test_draw_function_runs_the_students_functions():
     _check_figure(figure, numbers, 0.17, DEFAULT.unit_noise(sensors=("vision",)))
 
 
+@pytest.mark.slow
 def test_the_explorer_draws_the_students_numbers_not_the_engines():
     """A filter 1 cm off and a compensation 2 cm off show up in the lines and the MSEs."""
     def my_filter(y, A, C, Q, R, z0, P0):

@@ -118,6 +118,7 @@ def test_slider_conventions():
         assert (value - low) / step == pytest.approx(round((value - low) / step))
 
 
+@pytest.mark.slow
 def test_initial_figure_is_question_c():
     explorer = explore_fusion()
     _check_figure(explorer.figure, explorer.numbers, 1.5, 1.5,
@@ -126,6 +127,7 @@ def test_initial_figure_is_question_c():
 
 
 @pytest.mark.parametrize(("sigma_v", "sigma_p"), [(1.5, 4.5), (4.5, 1.5), (0.5, 6.0), (3.0, 3.0)])
+@pytest.mark.slow
 def test_slider_values_redraw_the_direct_computation(sigma_v, sigma_p):
     explorer = explore_fusion()
     before = explorer.png
@@ -136,6 +138,7 @@ def test_slider_values_redraw_the_direct_computation(sigma_v, sigma_p):
     assert explorer.png != before
 
 
+@pytest.mark.slow
 def test_noise_stays_fixed_across_slider_moves():
     explorer = explore_fusion()
     truth = DEFAULT.truth[:, 0]
@@ -160,6 +163,7 @@ def test_moving_sigma_p_leaves_the_vision_only_filter_alone():
     assert not np.allclose(second["fused"], first["fused"])
 
 
+@pytest.mark.slow
 def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     explorer = explore_fusion()
     axes = list(explorer.figure.axes)
@@ -183,6 +187,7 @@ def _texts(figure: Figure) -> list[str]:
     return [text.get_text() for text in figure.findobj(Text)]
 
 
+@pytest.mark.slow
 def test_only_the_shares_on_the_bars_change_among_the_figures_texts():
     """Text is the costliest artist to repaint: the numbers live beside the figure."""
     explorer = explore_fusion()
@@ -197,6 +202,7 @@ def test_only_the_shares_on_the_bars_change_among_the_figures_texts():
     assert explorer.numbers != numbers
 
 
+@pytest.mark.slow
 def test_the_right_panels_title_stays_in_the_cached_background():
     """Clear of the bars' axes area, so a move repaints the bars but not the title."""
     explorer = explore_fusion()
@@ -272,6 +278,7 @@ def test_bad_noise_raises():
                     noise=np.zeros((DEFAULT.n_steps, 1)))
 
 
+@pytest.mark.slow
 def test_vision_only_run_is_correct_and_kept_while_only_sigma_p_moves():
     noise = DEFAULT.unit_noise(sensors=FUSED)
     np.testing.assert_allclose(vision_only(DEFAULT, 2.0, noise).positions,
@@ -329,6 +336,7 @@ def my_filter(y, A, C, Q, R, z0, P0):
     return np.array(rows)
 
 
+@pytest.mark.slow
 def test_a_student_filter_draws_the_engines_picture_and_says_whose_it_is():
     explorer = explore_fusion(filter=my_filter)
     engine = explore_fusion()
@@ -351,6 +359,7 @@ def test_a_student_filter_draws_the_engines_picture_and_says_whose_it_is():
     assert explorer.title.endswith("(your my_filter)")
 
 
+@pytest.mark.slow
 def test_the_sliders_really_run_the_students_filter():
     calls = []
 

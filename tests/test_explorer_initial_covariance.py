@@ -52,6 +52,7 @@ def test_an_exponent_set_from_code_is_refused_not_clipped(explorer) -> None:
 
 
 @pytest.mark.parametrize("p0_variance", [1e-2, 1e5, 1e6, 1.0])
+@pytest.mark.slow
 def test_moving_the_slider_redraws_the_direct_computation(explorer, p0_variance) -> None:
     explorer.sliders["p0_variance"].value = p0_variance
     position_ax, velocity_ax = explorer.figure.axes
@@ -148,6 +149,7 @@ def test_static_display_carries_the_picture(explorer) -> None:
     assert html.escape(explorer.numbers) in bundle["text/html"]
 
 
+@pytest.mark.slow
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(9, 4))
     for p0_variance in (1e6, 1e-2, 31.6):
@@ -217,6 +219,7 @@ def test_the_students_filter_draws_what_the_engine_computes() -> None:
             np.testing.assert_allclose(bands[0][0], bands[1][0], rtol=1e-9, atol=1e-9)
 
 
+@pytest.mark.slow
 def test_the_explorer_draws_what_the_students_filter_returns() -> None:
     """The estimate and its MSEs come from the student's function, the band from the engine."""
     shifted, engine = Figure(), Figure()

@@ -146,6 +146,7 @@ def answers_of(name: str) -> list[Printed]:
 
 
 @pytest.mark.parametrize("name", sorted(EXPLORERS))
+@pytest.mark.slow
 def test_no_explorer_at_its_defaults_shows_a_number_its_notebooks_tasks_print(name) -> None:
     module, factory = EXPLORERS[name]
     explorer = getattr(module, factory)()

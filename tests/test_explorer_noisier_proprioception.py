@@ -100,6 +100,7 @@ def test_slider_conventions():
         assert (value - low) / step == pytest.approx(round((value - low) / step))
 
 
+@pytest.mark.slow
 def test_initial_figure_is_near_question_d_on_the_explorers_draw():
     explorer = explore_noisier_proprioception()
     _check_figure(explorer.figure, explorer.numbers, START_SIGMA_P,
@@ -108,6 +109,7 @@ def test_initial_figure_is_near_question_d_on_the_explorers_draw():
 
 
 @pytest.mark.parametrize("sigma_p", [0.5, 1.5, 9.0, 30.0])
+@pytest.mark.slow
 def test_slider_value_redraws_the_direct_computation(sigma_p):
     explorer = explore_noisier_proprioception()
     before = explorer.png
@@ -161,6 +163,7 @@ def test_steady_position_variances_against_the_filter_run_to_convergence():
     assert level == pytest.approx(run.estimate_covariances[-1, 0, 0], rel=1e-7)
 
 
+@pytest.mark.slow
 def test_redraw_reuses_the_panels_and_matches_a_fresh_draw():
     explorer = explore_noisier_proprioception()
     axes = list(explorer.figure.axes)
@@ -271,6 +274,7 @@ def my_filter(y, A, C, Q, R, z0, P0):
     return kalman_filter(y, A, C, Q, R, z0, P0).estimates
 
 
+@pytest.mark.slow
 def test_the_students_filter_drives_both_estimates_and_equals_the_engine():
     explorer = explore_noisier_proprioception(filter=my_filter)
     noise = EXPLORER_SCENARIO.unit_noise(sensors=FUSED)

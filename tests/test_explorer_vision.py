@@ -39,6 +39,7 @@ def test_slider_follows_the_conventions(explorer) -> None:
 
 
 @pytest.mark.parametrize("sigma_v", [0.1, 4.5, 10.0, 1.5])
+@pytest.mark.slow
 def test_moving_the_slider_redraws_the_direct_computation(explorer, sigma_v: float) -> None:
     previous_png = explorer.png
     explorer.sliders["sigma_v"].value = sigma_v
@@ -158,6 +159,7 @@ def test_scenario_outside_the_slider_range_is_refused(sigma_v: float) -> None:
         vision.explore_vision(scenario)
 
 
+@pytest.mark.slow
 def test_redraw_in_place_gives_the_same_picture_as_a_fresh_figure() -> None:
     reused = Figure(figsize=(9, 4))
     for sigma_v in (0.3, 9.0, 2.5):
@@ -191,6 +193,7 @@ def my_filter(y, A, C, Q, R, z0, P0):
     return np.array(kalman_filter(y, A, C, Q, R, z0, P0).estimates)
 
 
+@pytest.mark.slow
 def test_the_slider_runs_the_students_filter_and_says_so() -> None:
     calls = []
 

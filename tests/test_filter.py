@@ -161,6 +161,7 @@ def test_filter_is_consistent_on_truth_from_its_own_model() -> None:
     jerk=st.floats(min_value=0.0, max_value=1e4),
     two_sensors=st.booleans(),
 )
+@pytest.mark.slow
 def test_covariances_stay_symmetric_psd(p0, sigma_v, sigma_p, jerk, two_sensors) -> None:
     dt = 0.01
     sensors = ("vision", "proprioception") if two_sensors else ("vision",)

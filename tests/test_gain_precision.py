@@ -108,6 +108,7 @@ CASES = list(_cases())
 
 
 @pytest.mark.parametrize(("A", "C", "Q", "R", "P0"), CASES)
+@pytest.mark.slow
 def test_first_gain_is_exact_to_rounding(A, C, Q, R, P0) -> None:
     sequence = _covariance_sequence(1, A, C, Q, R, P0)
     errors = _column_errors(sequence.gains[0], _reference_gain(P0, C, R))

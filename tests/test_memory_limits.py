@@ -121,6 +121,7 @@ def test_absurd_sizes_are_refused_before_allocation(name: str) -> None:
     assert peak < 64 * 2**20, f"{peak / 2**20:.1f} MiB allocated before the refusal"
 
 
+@pytest.mark.slow
 def test_the_packs_largest_call_fits_under_the_limit() -> None:
     # Notebook 04's sweep: 25 σ_p values over 300 runs of 1 000 samples, two senses.
     sigma_p = np.geomspace(0.3, 100, 25)

@@ -163,6 +163,7 @@ def test_the_package_holds_no_readable_worked_answer() -> None:
         assert "lqe_helpers.reference" not in text and "import reference\n" not in text, path
 
 
+@pytest.mark.slow
 def test_the_student_pack_holds_no_worked_answer_of_01_or_05() -> None:
     """Neither the oracle, nor the checks' tests, nor the worked notebooks' saved functions."""
     from pathlib import Path

@@ -564,6 +564,7 @@ def test_source_follows_the_tag_convention(sources, key, name):
 
 
 @pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
+@pytest.mark.slow
 def test_no_solution_or_answer_text_survives(sources, editions, key, name):
     source = nbformat.read(sources[key] / name, as_version=4)
     student = nbformat.read(editions[key] / name, as_version=4)

@@ -389,6 +389,7 @@ def test_a_result_in_the_packs_readme_is_found(tmp_path):
         "README.md contains 1.259", "notes repeats a sentence of 01_fixture's answer source"]
 
 
+@pytest.mark.slow
 def test_the_packs_own_texts_give_no_answer_away(student_pack: StudentPack):
     texts = {name: (student_pack.folder / name).read_text("utf-8")
              for name in ("README.md", "STUDENT-PACK.md")}

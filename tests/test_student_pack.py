@@ -167,6 +167,7 @@ def test_the_notebooks_are_the_student_edition(pack, path):
                    for cell in nbformat.reads(packed, as_version=4).cells)
 
 
+@pytest.mark.slow
 def test_the_zip_is_the_same_every_time_and_replaced_safely(pack, tmp_path):
     archive, _ = pack
     again = sp.build_student_pack(ROOT, tmp_path / "out")

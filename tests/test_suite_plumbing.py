@@ -49,6 +49,7 @@ print(json.dumps({{"data": data, "page": (folder / "page.html").read_text(),
 """
 
 
+@pytest.mark.slow
 def test_two_sessions_at_once_build_an_artefact_once(tmp_path):
     script = tmp_path / "session.py"
     script.write_text(SESSION.format(tests=str(TESTS)))

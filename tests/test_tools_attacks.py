@@ -98,6 +98,7 @@ def test_an_odd_journal_file_is_one_line(tmp_path, kind):
 
 # --- huge files, files that are not files --------------------------------------------------
 
+@pytest.mark.slow
 def test_a_huge_file_in_the_way_is_hashed_in_pieces(tmp_path):
     """A 4 GB file listed in the manifest, under a 1 GB memory limit: no MemoryError."""
     out = tmp_path / "out"
@@ -127,6 +128,7 @@ def test_a_huge_manifest_is_one_line(tmp_path):
 
 
 @pytest.mark.parametrize("kind", ["fifo", "folder"])
+@pytest.mark.slow
 def test_a_source_named_like_a_notebook_that_is_not_a_file_is_refused(tmp_path, kind):
     source = tmp_path / "notebooks"
     write_notebook(source / "01_real.ipynb")
@@ -140,6 +142,7 @@ def test_a_source_named_like_a_notebook_that_is_not_a_file_is_refused(tmp_path, 
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_a_notebook_named_with_a_newline_keeps_every_line_one_line(tmp_path):
     source = tmp_path / "notebooks"
     write_notebook(source / "01_two\nlines.ipynb")
@@ -179,6 +182,7 @@ def test_clean_through_a_linked_output_folder_keeps_the_link(tmp_path):
     assert link.is_symlink() and list(real.iterdir()) == []
 
 
+@pytest.mark.slow
 def test_out_at_a_home_folder_adds_only_its_own_files(tmp_path):
     """Allowed on purpose: the tool adds its files and a manifest, and clean takes back
     exactly those."""
@@ -203,6 +207,7 @@ def test_out_at_a_home_folder_adds_only_its_own_files(tmp_path):
 
 
 @pytest.mark.parametrize("value", ["1e308", "1e9", "604801"])
+@pytest.mark.slow
 def test_a_time_limit_near_the_largest_float_is_one_line(tmp_path, value):
     path = write_notebook(tmp_path / "01.ipynb")
     result = run_tool("notebook_runner", str(path), "--timeout", value)
@@ -266,6 +271,7 @@ def read_only_mount(tmp_path):
         subprocess.run(["umount", str(folder)], check=False)
 
 
+@pytest.mark.slow
 def test_a_real_read_only_file_system(tmp_path, read_only_mount):
     source = tmp_path / "notebooks"
     write_notebook(source / "01_a.ipynb")

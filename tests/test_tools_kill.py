@@ -135,6 +135,7 @@ def test_a_build_killed_at_every_step_is_recovered(tmp_path, states):
     assert outcomes == {"old", "new"}  # killed both before and after the point of no return
 
 
+@pytest.mark.slow
 def test_the_recovery_says_what_it_did(tmp_path, states):
     _, new, count = states
     out = tmp_path / "out"
@@ -185,6 +186,7 @@ def test_a_new_folder_killed_at_every_step(tmp_path):
         assert snapshot(out) in ({}, new), n  # nothing (or an empty folder), or all of it
 
 
+@pytest.mark.slow
 def test_student_edition_killed_then_run_again_from_the_command_line(tmp_path):
     """The issue's case end to end: the next ``make student`` recovers and succeeds."""
     source = tmp_path / "notebooks"
@@ -260,6 +262,7 @@ def test_the_notebook_runner_killed_while_saving_recovers_on_its_next_run(tmp_pa
     assert sorted(path.name for path in tmp_path.iterdir()) == ["01.ipynb", "02.ipynb"]
 
 
+@pytest.mark.slow
 def test_the_recovery_never_overwrites_a_file_changed_after_the_kill(tmp_path, states):
     _, _, count = states
     out = tmp_path / "out"

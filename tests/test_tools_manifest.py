@@ -66,6 +66,7 @@ def poisoned_entries(course: Path, out: Path) -> dict[str, str]:
 @pytest.mark.parametrize("tool", TOOLS)
 @pytest.mark.parametrize("how", ["dot-dot", "through a sub-folder",
                                  "through a symlinked sub-folder", "absolute"])
+@pytest.mark.slow
 def test_a_rebuild_never_deletes_what_a_poisoned_manifest_lists(tmp_path, monkeypatch, tool,
                                                                 how):
     course = make_course(tmp_path / "course")
@@ -84,6 +85,7 @@ def test_a_rebuild_never_deletes_what_a_poisoned_manifest_lists(tmp_path, monkey
     assert snapshot(out) == before_out
 
 
+@pytest.mark.slow
 def test_the_issue_case_from_the_command_line(tmp_path):
     """A listed ``../../notebooks/01_…`` with its checksum: one error line, exit 1."""
     course = make_course(tmp_path / "course")

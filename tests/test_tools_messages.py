@@ -86,6 +86,7 @@ def test_a_non_utf8_file_in_the_pack_is_named(tmp_path, where):
     assert not (tmp_path / "out").exists()
 
 
+@pytest.mark.slow
 def test_a_deeply_nested_notebook_is_named_by_every_tool(tmp_path):
     source = tmp_path / "notebooks"
     deep = source / "01_deep.ipynb"
@@ -107,6 +108,7 @@ def limit_file_size(limit: int):
 
 
 @pytest.mark.parametrize("exists", [False, True])
+@pytest.mark.slow
 def test_file_too_large_names_the_file(tmp_path, exists):
     source = tmp_path / "notebooks"
     big = [new_markdown_cell("A long introduction. " * 5000)]  # 100 kB

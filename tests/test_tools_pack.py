@@ -73,6 +73,7 @@ def test_a_fifo_in_the_tests_stops_the_build_without_blocking(tmp_path, course):
 
 
 @pytest.mark.parametrize("out", ["notebooks/pack", "lqe_helpers", "tests/out", ".", "..", "/"])
+@pytest.mark.slow
 def test_an_output_folder_overlapping_what_the_pack_copies_is_refused(tmp_path, course, out):
     before = snapshot(tmp_path)
     result = run_tool("student_pack", "--root", str(course), "--out", out, cwd=course)
@@ -88,6 +89,7 @@ def test_an_output_folder_beside_the_sources_is_fine(tmp_path, course):
     assert written.name == student_pack.ZIP_NAME
 
 
+@pytest.mark.slow
 def test_the_pack_refuses_a_folder_another_tool_holds(tmp_path, course):
     """Two tools at once on one folder: the second stops at once with one line."""
     from lqe_helpers.authoring.transaction import FolderLock

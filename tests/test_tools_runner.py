@@ -105,6 +105,7 @@ def test_an_edit_saved_during_the_run_is_kept(tmp_path, how):
     {"nbformat": 4, "nbformat_minor": -1, "metadata": {}, "cells": []},
     {"nbformat": True, "nbformat_minor": 5, "metadata": {}, "cells": []},
 ])
+@pytest.mark.slow
 def test_json_that_is_not_a_notebook_is_refused_before_anything_runs(tmp_path, content):
     good = code_notebook(tmp_path / "01_good.ipynb", "print('ran')")
     odd = tmp_path / "02_package.ipynb"
@@ -118,6 +119,7 @@ def test_json_that_is_not_a_notebook_is_refused_before_anything_runs(tmp_path, c
     assert snapshot(tmp_path) == before
 
 
+@pytest.mark.slow
 def test_a_fifo_named_like_a_notebook_is_refused_without_blocking(tmp_path):
     fifo = tmp_path / "01_pipe.ipynb"
     os.mkfifo(fifo)
@@ -127,6 +129,7 @@ def test_a_fifo_named_like_a_notebook_is_refused_without_blocking(tmp_path):
         f"error: notebooks must be existing .ipynb files, got {fifo}"]
 
 
+@pytest.mark.slow
 def test_a_deeply_nested_notebook_names_the_file(tmp_path):
     deep = tmp_path / "01_deep.ipynb"
     deep.write_text('{"nbformat": 4, "nbformat_minor": 5, "cells": [], "metadata": {"a": '
@@ -174,6 +177,7 @@ def random_outputs(rng: random.Random) -> list[dict]:
     return outputs
 
 
+@pytest.mark.slow
 def test_the_linear_merge_gives_what_nbclient_gives():
     rng = random.Random(19)
     for _ in range(5000):
@@ -258,6 +262,7 @@ def test_a_signal_stops_the_kernel_and_ends_the_run_with_one_line(tmp_path, how,
     assert snapshot(tmp_path) == before  # no notebook changed, no output folder
 
 
+@pytest.mark.slow
 def test_the_time_limit_holds_even_if_the_client_hangs(tmp_path, monkeypatch):
     """nbclient stuck in a cell (here: it never returns from it, whatever its own time
     limit says): the run stops a grace period past the limit all the same."""

@@ -80,6 +80,7 @@ def checks_of(monkeypatch):
     (noisier_proprioception, "explore_noisier_proprioception", "sigma_p", 7.5, 1),
     (bias, "explore_bias", "sigma_v", 3.5, 2),            # with the signal, and vision only
 ], ids=["vision σ_v", "P0", "fusion σ_v", "fusion σ_p", "noisier σ_p", "bias σ_v"])
+@pytest.mark.slow
 def test_a_slider_value_is_checked_once_per_filter_it_reaches(checks_of, module, factory,
                                                              slider, value, filters) -> None:
     explorer = getattr(module, factory)()
