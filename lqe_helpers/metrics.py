@@ -104,6 +104,11 @@ class Interval:
     def __str__(self) -> str:
         return format(self, "")
 
+    def __sub__(self, other: object) -> Interval:
+        raise TypeError("intervals cannot be subtracted: the difference of two conditions is "
+                        "mean_ci95 of their per-run differences (paired, run by run)")
+    __rsub__ = __sub__
+
 
 def mean_ci95(samples: np.ndarray) -> Interval:
     """Mean of independent samples with a Student-t 95 % confidence interval.
@@ -119,7 +124,10 @@ def mean_ci95(samples: np.ndarray) -> Interval:
     Interval
         ``mean ± t(0.975, runs − 1) · s / √runs``.
     """
-    samples = validation.finite_array("samples", samples, min_ndim=1)
+    samples = validation.finite_array("samples", samples)
+    if samples.ndim == 0:
+        raise ValueError(f"samples must be one value per run (at least 2), got one number "
+                         f"({samples.item():.6g}): pass the per-run values, not their mean")
     if samples.ndim != 1 or samples.size < 2:
         raise ValueError(
             f"samples must be a 1-D array of at least 2 runs, got shape {samples.shape}"

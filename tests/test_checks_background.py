@@ -11,6 +11,7 @@ import pytest
 from check_outcomes import assert_fails, assert_passes
 
 from lqe_helpers import checks
+from lqe_helpers.scenario import DEFAULT
 
 # --- check_transition_matrix ----------------------------------------------------------------
 
@@ -40,6 +41,16 @@ def test_check_transition_matrix_names_each_typical_mistake(mistake, phrase):
     messages = assert_fails(phrase, checks.check_transition_matrix,
                             lambda dt: make_A(dt, mistake=mistake))
     assert "np." not in messages and "@" not in messages
+
+
+def test_check_transition_matrix_judges_the_tasks_A_too(capsys):
+    line = assert_passes(capsys, checks.check_transition_matrix, make_A, make_A(DEFAULT.dt))
+    assert line.endswith(f"and A is its value at Δt = {DEFAULT.dt:g} s")
+    assert_fails("A is eq. (4)'s A at Δt = 0.1 s; the task's A is my_transition_matrix("
+                 "DEFAULT.dt)", checks.check_transition_matrix, make_A, make_A(0.1))
+    assert_fails("A is not my_transition_matrix(DEFAULT.dt)", checks.check_transition_matrix,
+                 make_A, make_A(DEFAULT.dt).T)
+    assert_fails("A must be", checks.check_transition_matrix, make_A, np.eye(2))
 
 
 def test_check_transition_matrix_rejects_a_hard_coded_answer():

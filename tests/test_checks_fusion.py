@@ -73,6 +73,18 @@ FUSED = ("vision", "proprioception")
 SIGMA = 1.5
 
 
+def plain_loop(y, A, C, Q, R, z0, P0):
+    """Eq. (5) as a student writes it, without the oracle's shape checks: numpy broadcasts a
+    reading y_j of shape (1,) against a prediction C A ẑ of shape (2,) without a word."""
+    z, P, estimates = z0, P0, []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        estimates.append(z)
+    return np.array(estimates)
+
+
 def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     """Task 2 as a student writes it, with their filter, optionally with one slip."""
     trial = experiments.track(DEFAULT, FUSED)
@@ -85,6 +97,8 @@ def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     fused, vision = fused_all[:, 0], vision_all[:, 0]
     if mistake == "proprioception column":
         vision = reference.lqe_filter(y[:, 1:], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]
+    if mistake == "full C and R for vision":   # numpy broadcasts y_j (1,) against C A ẑ (2,)
+        vision = plain_loop(y[:, :1], A, C, Q, R, z0, P0)[:, 0]
     if mistake == "velocity":
         fused = fused_all[:, 1]
     if mistake == "velocity in both":
@@ -120,6 +134,9 @@ def test_check_fusion_trial_passes_the_worked_solution(capsys) -> None:
 @pytest.mark.parametrize(("mistake", "phrase"), [
     ("proprioception column", "vision_positions is not right: it is the filter run on "
                               "proprioception's readings (column 1 of y)"),
+    ("full C and R for vision", "vision_positions is not right: the vision-only run kept both "
+                                "senses' C and R: with vision's readings y[:, :1] it needs "
+                                "C[:1] (1, 3) and R[:1, :1] (1, 1) too"),
     ("velocity", "fused_positions is not right: it is column 1 of the estimates, the velocity"),
     ("averaged readings", "fused_positions is not right: the two readings were averaged and "
                           "filtered as one sense"),

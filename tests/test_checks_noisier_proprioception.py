@@ -88,6 +88,18 @@ def test_check_noisier_sense_wants_a_number_and_a_matrix() -> None:
 # ------------------------------------------------------------------------------------------
 
 
+def plain_loop(y, A, C, Q, R, z0, P0):
+    """Eq. (5) as a student writes it, without the oracle's shape checks: numpy broadcasts a
+    reading y_j of shape (1,) against a prediction C A ẑ of shape (2,) without a word."""
+    z, P, estimates = z0, P0, []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        estimates.append(z)
+    return np.array(estimates)
+
+
 def task2(slip: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     """Task 2 as a student writes it, with the student's filter, and one ``slip``."""
     A, C, Q, z0, P0, R = model()
@@ -101,6 +113,8 @@ def task2(slip: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     r_vision = R[1:, 1:] if slip == "R of proprioception" else R[:1, :1]
     vision_column = 1 if slip == "velocity" else 0
     vision_positions = my_filter(seen, A, C[:1], Q, r_vision, z0, P0)[:, vision_column]
+    if slip == "full C and R for vision":       # numpy broadcasts y_j (1,) against C A ẑ (2,)
+        vision_positions = plain_loop(seen, A, C, Q, R, z0, P0)[:, 0]
     if slip == "raw readings":
         vision_positions = y[:, 0]
     if slip == "swapped":
@@ -129,6 +143,8 @@ def test_check_noisier_trial_passes_the_worked_answer(capsys) -> None:
     ("R of proprioception", "the vision-only filter's R holds proprioception's variance σ_p²"),
     ("sigmas in R", "vision_positions is not right: R holds σ (cm) where the variance σ²"),
     ("raw readings", "vision_positions is not right: these are vision's readings"),
+    ("full C and R for vision", "vision_positions is not right: the vision-only run kept both "
+                                "senses' C and R"),
     ("MSEs swapped", "mse_vision_trial = 0.273901 cm² is not right: it is the fused filter's "
                      "MSE"),
     ("whole trial", "mse_vision_trial = 0.363507 cm² is not right"),

@@ -332,6 +332,8 @@ def task2(slip: str = ""):
             return y, estimates[:, 0]
         if slip == "estimates only":
             return estimates
+        if slip == "swapped":
+            return estimates, y
         if slip == "no return":
             return None
         if slip == "engine":
@@ -348,16 +350,18 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
 @pytest.mark.parametrize(("slip", "phrase"), [
     ("truth not a column", "truth + σ_v · noise broadcasts to (n, n); the readings are "
                            "truth[:, None] + σ_v · noise, shape (n, 1)"),
-    ("flat", "the readings y that vision_trial(1.5) returns are flat, shape (1000,)"),
-    ("sigma squared in y", "the readings y that vision_trial(1.5) returns is not right: the "
-                           "readings were made with σ_v² instead of σ_v"),
+    ("flat", "the first array vision_trial(1.5) returns (the readings y) is flat, shape "
+             "(1000,)"),
+    ("sigma squared in y", "the first array vision_trial(1.5) returns (the readings y) is not "
+                           "right: the readings were made with σ_v² instead of σ_v"),
     ("no sigma in y", "the readings were made without σ_v (truth + noise)"),
-    ("R = sigma", "the estimates that vision_trial(1.5) returns is not right: R holds σ_v "
-                  "(cm) where its variance σ_v² (cm²) belongs"),
+    ("R = sigma", "the second array vision_trial(1.5) returns (the estimates) is not right: "
+                  "R holds σ_v (cm) where its variance σ_v² (cm²) belongs"),
     ("R = sigma^4", "R holds σ_v⁴"),
-    ("always 1.5", "vision_trial(4.5) returns is not right: they are the readings of σ_v = "
-                   "1.5 cm"),
-    ("positions only", "hold one number per reading (the positions only?)"),
+    ("always 1.5", "vision_trial(4.5) returns (the readings y) is not right: they are the "
+                   "readings of σ_v = 1.5 cm"),
+    ("positions only", "holds one number per reading (the positions only?)"),
+    ("swapped", "vision_trial(1.5) returns the estimates first and the readings second"),
     ("estimates only", "vision_trial(1.5) must return two things, the readings y and the "
                        "estimates"),
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),

@@ -73,6 +73,8 @@ def test_convergence_time_interval_brackets_the_estimate() -> None:
     ("call", "message"),
     [
         (lambda: metrics.mean_ci95([1.0]), "samples must be a 1-D array of at least 2 runs"),
+        (lambda: metrics.mean_ci95(0.14463), r"samples must be one value per run \(at least "
+                                             r"2\), got one number \(0.14463\)"),
         (lambda: metrics.mean_ci95([1.0, np.nan]), "samples must contain only finite"),
         (
             lambda: metrics.mse(np.zeros(3), np.zeros(4)),
@@ -163,3 +165,12 @@ def test_power_law_exponent_of_exact_power_laws():
 def test_power_law_exponent_bad_input(x, y, name):
     with pytest.raises(ValueError, match=name):
         metrics.power_law_exponent(x, y)
+
+
+def test_two_intervals_cannot_be_subtracted_the_runs_are_paired_first() -> None:
+    first = metrics.mean_ci95(np.array([1.0, 2.0, 3.0]))
+    with pytest.raises(TypeError, match="intervals cannot be subtracted: the difference of two "
+                                        "conditions is mean_ci95 of their per-run differences"):
+        first - first
+    with pytest.raises(TypeError, match="intervals cannot be subtracted"):
+        1.0 - first

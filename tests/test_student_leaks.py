@@ -225,6 +225,45 @@ def find_leaks(source: nbformat.NotebookNode, student: nbformat.NotebookNode) ->
     return leaks
 
 
+def printed_before_the_tasks(notebook: nbformat.NotebookNode) -> list[str]:
+    """Results printed later that a code cell before the first task already printed.
+
+    The student runs the notebook from the top, so a given cell above the first task that
+    prints a number a task or its given cells print later (a table of constants showing
+    the σ_j a task derives, say) gives it away as surely as prose would. Only the core
+    path's results count (a Going further task may print a given fact, such as the path's
+    peak acceleration, beside its own numbers), and only the cells before the first task
+    are held to this (later cells may repeat earlier results). The question's numbers and
+    typed inputs are excepted as in :func:`printed_results`.
+    """
+    allowed = {number_value(token) for token in numbers(question_text(notebook))}
+    allowed |= code_literals(notebook)
+    first_task = next((index for index, cell in enumerate(notebook.cells)
+                       if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
+    core_end = next((index for index, cell in enumerate(notebook.cells)
+                     if cell.cell_type == "markdown"
+                     and re.search(r"^##\s+Going further", cell.source, re.M | re.I)),
+                    len(notebook.cells))
+    early: dict[Decimal, str] = {}
+    leaks = []
+    for index, cell in enumerate(notebook.cells[:core_end]):
+        if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+            continue
+        values = set()
+        for output in cell.get("outputs", []):
+            values |= results(output_text(output)) - allowed
+        if index < first_task:
+            for value in values:
+                early.setdefault(value, se.cell_place("source", index, cell))
+        else:
+            leaks += [f"{early[value]} prints {value} before the tasks; "
+                      f"{se.cell_place('source', index, cell)} computes it"
+                      for value in sorted(values & set(early))]
+            for value in values & set(early):
+                del early[value]
+    return leaks
+
+
 def student_of(notebook: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
     return nbformat.reads(se.student_edition(notebook, name), as_version=4)
 
@@ -337,6 +376,24 @@ def test_the_student_edition_gives_no_answer_away(student_edition: StudentEditio
     student = nbformat.read(student_edition.folder / path.name, as_version=4)
     leaks = find_leaks(source, student)
     assert not leaks, f"{len(leaks)} leak(s) in the student edition:\n" + "\n".join(leaks)
+
+
+def test_a_given_cell_that_prints_a_tasks_result_before_it_is_found():
+    table = new_code_cell("print('constants: MSE 1.259 cm²')", execution_count=1,
+                          outputs=[new_output("stream", name="stdout",
+                                              text="constants: MSE 1.259 cm²\n")])
+    notebook = leak_fixture()
+    notebook.cells.insert(1, table)
+    assert printed_before_the_tasks(notebook) == [
+        f"{se.cell_place('source', 1, table)} prints 1.259 before the tasks; "
+        f"{se.cell_place('source', 3, notebook.cells[3])} computes it"]
+    assert printed_before_the_tasks(leak_fixture()) == []
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_no_cell_prints_a_tasks_result_before_the_task(path):
+    leaks = printed_before_the_tasks(nbformat.read(path, as_version=4))
+    assert not leaks, "\n".join(leaks)
 
 
 def test_abbreviations_do_not_end_a_sentence():

@@ -154,8 +154,9 @@ STUDENT_NOTE = (
     "> **Student edition.** Cells starting with `# Task:` are yours to write: replace "
     "their `raise NotImplementedError(...)` line with code that does what the comment "
     "asks, and run the notebook from the top. Write your answers where it says "
-    "**Your answer**. The interactive explorers work at any time: run the first code "
-    "cell, then the explorer's cell."
+    "**Your answer**. An explorer runs once the first code cell has run; one that runs "
+    "your own function (`my_filter` from notebook 01, `compensate`) shows its figure once "
+    "that function passes its check, and until then says what to do."
 )
 
 

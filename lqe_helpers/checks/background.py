@@ -68,17 +68,21 @@ def _transition_mistakes(dt: float) -> dict[str, tuple[np.ndarray, str]]:
     }
 
 
-def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
+def check_transition_matrix(make_A: Callable[[float], np.ndarray], A: object = None) -> None:
     """Check a student's ``make_A(dt)`` against Tutorial eq. (4) (constant acceleration).
 
     The function is called at several time steps (:data:`_TRANSITION_DTS`, s) and must
     return the 3 × 3 matrix ``[[1, Δt, Δt²/2], [0, 1, Δt], [0, 0, 1]]`` for the state
-    [p, v, a], equal to :func:`model.transition_matrix` within :data:`MATRIX_RTOL`.
+    [p, v, a], equal to :func:`model.transition_matrix` within :data:`MATRIX_RTOL`. The
+    task's ``A`` (which later tasks use), if given, must be that matrix at the
+    scenario's Δt.
 
     Parameters
     ----------
     make_A : callable
         The student's function of the time step Δt (s).
+    A : array_like, shape (3, 3), optional
+        The student's ``A = make_A(DEFAULT.dt)``.
 
     Raises
     ------
@@ -102,9 +106,12 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
         answers[dt] = array
     wrong = [dt for dt, array in answers.items() if not close(array, right[dt], MATRIX_RTOL)]
     if not wrong:
+        if A is not None:
+            _check_task_A(A)
         passed(f"{name} gives eq. (4)'s A (constant acceleration) at {len(answers)} time "
                f"steps from {min(_TRANSITION_DTS):g} to {max(_TRANSITION_DTS):g} s, to "
-               f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}")
+               f"{tolerance_text(MATRIX_RTOL)}, {time_limit_text()}"
+               + (f", and A is its value at Δt = {DEFAULT.dt:g} s" if A is not None else ""))
         return
     first, last = answers[_TRANSITION_DTS[0]], answers[_TRANSITION_DTS[-1]]
     if len(wrong) < len(answers) and np.allclose(first, last) and not np.allclose(
@@ -121,6 +128,22 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray]) -> None:
     raise CheckFailed(
         f"{name}({dt:g}) is not eq. (4)'s A: row 0 must turn [p, v, a] into the Taylor step "
         f"of the position, row 1 that of the velocity, row 2 keeps the acceleration")
+
+
+def _check_task_A(A: object) -> None:
+    """``A`` must be eq. (4)'s A at the scenario's Δt (the matrix later tasks use)."""
+    A = argument_array(A, "A", "the transition matrix at DEFAULT.dt, an array of shape (3, 3)",
+                       shape=(3, 3))
+    if close(A, model.transition_matrix(DEFAULT.dt), MATRIX_RTOL):
+        return
+    for dt in (0.1, 0.001, 1.0, 0.02, 0.005):
+        if close(A, model.transition_matrix(dt), MATRIX_RTOL):
+            raise CheckFailed(
+                f"A is eq. (4)'s A at Δt = {dt:g} s; the task's A is my_transition_matrix("
+                f"DEFAULT.dt), the scenario's Δt = {DEFAULT.dt:g} s (later tasks use it)")
+    raise CheckFailed(
+        f"A is not my_transition_matrix(DEFAULT.dt), eq. (4)'s A at Δt = {DEFAULT.dt:g} s: "
+        f"set A = my_transition_matrix(DEFAULT.dt) (later tasks use it)")
 
 
 #: (states k, inputs r) of the random cases of :func:`check_covariance_step`.

@@ -176,6 +176,13 @@ def judge_noise_matrix(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
 # Task 2: one trial, filtered both ways
 # ------------------------------------------------------------------------------------------
 
+#: The vision-only run given vision's readings y[:, :1] but both senses' C and R: a loop of
+#: eq. (5) then compares the one reading with both rows of C A ẑ (numpy broadcasts it), which
+#: is the fused filter fed vision's reading twice.
+VISION_WITH_BOTH_SENSES = ("the vision-only run kept both senses' C and R: with vision's "
+                           "readings y[:, :1] it needs C[:1] (1, 3) and R[:1, :1] (1, 1) too")
+
+
 def engine_positions(readings: np.ndarray, sigmas: list[float], column: int = 0) -> np.ndarray:
     """Column ``column`` of the engine's estimates on ``readings`` (n, m), R = diag(σ²).
 
@@ -211,6 +218,8 @@ def _trial() -> dict[str, object]:
             velocity: engine_positions(y[:, :1], [sigma_v], 1),
             sigma_for_variance: engine_positions(y[:, :1], root["vision"]),
             "these are vision's readings, not the filter's estimate": y[:, 0],
+            VISION_WITH_BOTH_SENSES: engine_positions(np.repeat(y[:, :1], 2, axis=1),
+                                                      [sigma_v, sigma_p]),
         },
         "fused": {
             "it is the vision-only filter's estimate: fused_positions comes from the filter "

@@ -24,7 +24,13 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .fusion import engine_positions, judge_noise_matrix, judge_together, position_array
+from .fusion import (
+    VISION_WITH_BOTH_SENSES,
+    engine_positions,
+    judge_noise_matrix,
+    judge_together,
+    position_array,
+)
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
     FUNCTION_RTOL,
@@ -166,6 +172,8 @@ def _trial() -> dict[str, dict]:
             velocity: engine_positions(y[:, :1], [SIGMA_V], 1),
             sigma_for_variance: engine_positions(y[:, :1], root["vision"]),
             raw: y[:, 0],
+            VISION_WITH_BOTH_SENSES: engine_positions(np.repeat(y[:, :1], 2, axis=1),
+                                                      [SIGMA_V, SIGMA_P]),
         },
         "fused": {
             "it is the vision-only filter's estimate: the fused filter reads both columns "

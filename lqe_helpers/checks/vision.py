@@ -317,20 +317,23 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
                               arg_names=_TRIAL_ARGS, shape_hint=_TRIAL_SHAPE_HINT,
                               forbid=(kalman_filter,))
         y, estimates = _trial_output(output, name, sigma)
-        label = f"the readings y that {name}({sigma:g}) returns"
+        if np.shape(y) == (n, 3) and np.shape(estimates) == (n, 1):
+            raise CheckFailed(f"{name}({sigma:g}) returns the estimates first and the readings "
+                              f"second; return y, then the estimates, as the task says")
+        label = f"the first array {name}({sigma:g}) returns (the readings y)"
         y = student_result(y, name=label, what=f"the readings, an array of shape ({n}, 1)")
         if y.shape == (n, n):
-            raise CheckFailed(f"{label} have shape ({n}, {n}): {_TRIAL_SHAPE_HINT}")
+            raise CheckFailed(f"{label} has shape ({n}, {n}): {_TRIAL_SHAPE_HINT}")
         if y.shape == (n,):
-            raise CheckFailed(f"{label} are flat, shape ({n},); keep one column per sensor, "
+            raise CheckFailed(f"{label} is flat, shape ({n},); keep one column per sensor, "
                               f"shape ({n}, 1), as my_filter reads one row per time step")
         judge(label, y, right["y"], FUNCTION_RTOL, unit="cm", mistakes=right["y_mistakes"],
               what="truth + σ_v · noise on the scenario's draw")
-        label = f"the estimates that {name}({sigma:g}) returns"
+        label = f"the second array {name}({sigma:g}) returns (the estimates)"
         estimates = student_result(estimates, name=label,
                                    what=f"the estimates of my_filter, shape ({n}, 3)")
         if estimates.shape == (n,):
-            raise CheckFailed(f"{label} hold one number per reading (the positions only?); "
+            raise CheckFailed(f"{label} holds one number per reading (the positions only?); "
                               f"return all the estimates my_filter gives, shape ({n}, 3)")
         judge(label, estimates, right["estimates"], FUNCTION_RTOL,
               mistakes=right["estimate_mistakes"],
