@@ -125,7 +125,7 @@ def _interval_parts(interval: object, name: str) -> tuple[object, object, object
         found = "None" if interval is None else f"a {type(interval).__name__}"
     raise CheckFailed(
         f"{name} is {found}; it must be the metrics.Interval that metrics.mean_ci95 returns "
-        f"(its mean, low and high), since a difference means little without its 95 % "
+        f"(its mean, low and high), since a Monte Carlo mean means little without its 95 % "
         f"interval")
 
 

@@ -10,7 +10,9 @@ everywhere; :func:`save` and :func:`load` carry a function from one notebook to 
 - ``calling``: :func:`call`, with copies of the inputs and a time limit;
 - ``results``: :func:`result_array` and :func:`array_problem`, a real number array or
   one line saying what came instead;
-- ``keeping``: :func:`save` and :func:`load`.
+- ``keeping``: :func:`save` and :func:`load`;
+- ``guards``: what a loaded ``my_filter`` or ``compensate`` checks of its inputs' sizes, so
+  that an R that does not fit its readings is named at the student's own call.
 """
 
 from .calling import NOT_WRITTEN_ADVICE, TIME_LIMIT, call, function_name

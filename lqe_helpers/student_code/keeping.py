@@ -19,6 +19,7 @@ import numpy as np
 
 from .calling import call, function_name
 from .errors import NotSavedYet, StudentCodeError, error_text, short_repr
+from .guards import guarded
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -182,7 +183,10 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     Returns
     -------
     callable
-        The function. If its file does not exist yet, a stand-in of the same name that
+        The function, with the inputs guard of its name if the pack has one
+        (:func:`~lqe_helpers.student_code.guards.guarded`: ``my_filter`` given an R that
+        does not fit its readings stops with one line naming R). If its file does not exist
+        yet, a stand-in of the same name that
         raises :class:`NotSavedYet` (one line naming the notebook whose task writes it)
         whenever it is called, so the rest of the notebook (an explorer, say) still runs
         and every use of the function says what to do; :func:`load` then prints that
@@ -216,7 +220,7 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     function = namespace.get(name)
     if not isinstance(function, types.FunctionType):
         raise StudentCodeError(f"{shown} does not define a function {name}")
-    return function
+    return guarded(name, function)
 
 
 def _not_saved_yet(name: str, message: str) -> Callable:

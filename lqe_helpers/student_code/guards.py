@@ -1,0 +1,107 @@
+"""Input guards of the functions a student saves: a wrong-sized input named before it runs.
+
+A student's ``my_filter`` loaded in a later notebook meets inputs its author never tried:
+two senses, one sense cut out of two. Given ``y[:, :1]`` with both senses' R, a loop of
+eq. (5) stops inside the saved file with numpy's "matmul: … mismatch in its core
+dimension", or (with both senses' C) runs on silently by broadcasting. :func:`guarded`
+wraps such a function so that inputs whose sizes do not agree stop at the student's own
+call with one line naming the input and the size it needs.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+
+import numpy as np
+
+from .errors import StudentCodeError
+
+__tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
+
+
+def _sized(value: object) -> tuple[int, ...] | None:
+    try:
+        return np.shape(value)
+    except ValueError:  # a ragged list: the student's function reports it itself
+        return None
+
+
+def filter_inputs_problem(y: object, A: object, C: object, Q: object, R: object, z0: object,
+                          P0: object) -> str | None:
+    """What does not fit in the inputs of ``my_filter(y, A, C, Q, R, z0, P0)``, or None.
+
+    With k states and m sensors: y (n, m), A, Q and P0 (k, k), C (m, k), R (m, m), z0 (k,).
+    """
+    shapes = {name: _sized(value) for name, value in
+              (("y", y), ("A", A), ("C", C), ("Q", Q), ("R", R), ("z0", z0), ("P0", P0))}
+    if any(shape is None for shape in shapes.values()):
+        return None
+    if len(shapes["y"]) != 2:
+        return (f"y has shape {shapes['y']}; it must be (n, m): one row per time step, one "
+                f"column per sensor (a single sensor's readings as y[:, :1] or y[:, None])")
+    m = shapes["y"][1]
+    if len(shapes["A"]) != 2 or shapes["A"][0] != shapes["A"][1]:
+        return f"A has shape {shapes['A']}; it must be square, (k, k) for k states"
+    k = shapes["A"][0]
+    sensors = f"{m} sensor{'s' * (m != 1)} (the columns of y, shape {shapes['y']})"
+    if shapes["C"] != (m, k):
+        cut = " (for vision alone, C[:1] with y[:, :1])" if m == 1 else ""
+        return (f"C has shape {shapes['C']}; for {sensors} and {k} states it must be "
+                f"({m}, {k}): one row per sensor{cut}")
+    if shapes["R"] != (m, m):
+        cut = " (for vision alone, R[:1, :1])" if m == 1 else ""
+        return (f"R has shape {shapes['R']}; for {sensors} it must be ({m}, {m}): one row and "
+                f"column per sensor{cut}")
+    for name, needed in (("Q", (k, k)), ("P0", (k, k)), ("z0", (k,))):
+        if shapes[name] != needed:
+            return f"{name} has shape {shapes[name]}; for {k} states it must be {needed}"
+    return None
+
+
+def compensate_inputs_problem(estimates: object, A: object, delay_steps: object) -> str | None:
+    """What does not fit in the inputs of ``compensate(estimates, A, delay_steps)``, or None."""
+    shape, a_shape = _sized(estimates), _sized(A)
+    if shape is None or a_shape is None:
+        return None
+    if len(shape) != 2:
+        return (f"estimates has shape {shape}; it must be (n, k): one row ẑ_j per time step "
+                f"(all the states, not only the positions)")
+    if a_shape != (shape[1], shape[1]):
+        return (f"A has shape {a_shape}; for estimates of {shape[1]} states it must be "
+                f"({shape[1]}, {shape[1]})")
+    if isinstance(delay_steps, (bool, np.bool_)) or not isinstance(
+            delay_steps, (int, np.integer)) or not 0 <= delay_steps < shape[0]:
+        return (f"delay_steps is {delay_steps!r}; it must be a whole number of samples δ, "
+                f"0 <= δ < {shape[0]} (δ = d / Δt)")
+    return None
+
+
+#: The guard of each function the pack's notebooks save, by name.
+GUARDS: dict[str, Callable[..., str | None]] = {
+    "my_filter": filter_inputs_problem,
+    "compensate": compensate_inputs_problem,
+}
+
+
+def guarded(name: str, function: Callable) -> Callable:
+    """``function`` with the inputs guard of ``name`` (:data:`GUARDS`), if it has one.
+
+    The wrapper calls the student's function unchanged when the inputs fit; otherwise it
+    raises :class:`StudentCodeError`: "my_filter was given R of shape (2, 2); …".
+    """
+    guard = GUARDS.get(name)
+    if guard is None:
+        return function
+
+    @functools.wraps(function)
+    def checked(*args: object, **kwargs: object) -> object:
+        try:
+            problem = guard(*args, **kwargs)
+        except TypeError:  # the wrong number of arguments: the student's function says so
+            problem = None
+        if problem is not None:
+            raise StudentCodeError(f"{name} was given inputs that do not fit: {problem}")
+        return function(*args, **kwargs)
+
+    return checked

@@ -1,0 +1,100 @@
+"""A saved my_filter or compensate, loaded in a later notebook, names an input that does not fit.
+
+The trials' slip: notebook 03's vision-only run given y[:, :1] with both senses' R stopped in
+numpy inside my_functions/my_filter.py ("matmul: … mismatch in its core dimension"); with
+both senses' C it ran on silently (numpy broadcasts the one reading against two rows).
+"""
+
+from __future__ import annotations
+
+import re
+
+import numpy as np
+import pytest
+
+from lqe_helpers import student_code
+from lqe_helpers.student_code import StudentCodeError
+from lqe_helpers.student_code.guards import compensate_inputs_problem, filter_inputs_problem
+
+SAVED_FILTER = '''\
+def my_filter(y, A, C, Q, R, z0, P0):
+    z, P, out = z0, P0, []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        out.append(z)
+    return np.array(out)
+'''
+
+A = np.array([[1.0, 0.01, 5e-5], [0.0, 1.0, 0.01], [0.0, 0.0, 1.0]])
+C2 = np.array([[1.0, 0.0, 0.0], [1.0, 0.0, 0.0]])
+R2 = np.diag([2.25, 20.25])
+Y2 = np.arange(20.0).reshape(10, 2)
+MODEL = {"A": A, "Q": np.eye(3), "z0": np.zeros(3), "P0": np.eye(3)}
+
+
+@pytest.fixture
+def loaded(tmp_path):
+    folder = tmp_path / "my_functions"
+    folder.mkdir()
+    (folder / "my_filter.py").write_text(f"{student_code.SAVE_HEADER}\nimport numpy as np\n\n\n"
+                                         f"{SAVED_FILTER}", encoding="utf-8")
+    return student_code.load("my_filter", folder)
+
+
+def call(my_filter, y, C, R):
+    return my_filter(y, MODEL["A"], C, MODEL["Q"], R, MODEL["z0"], MODEL["P0"])
+
+
+def test_inputs_that_fit_run_the_students_function_unchanged(loaded):
+    assert loaded.__name__ == "my_filter"
+    fused = call(loaded, Y2, C2, R2)
+    vision = call(loaded, Y2[:, :1], C2[:1], R2[:1, :1])
+    assert fused.shape == vision.shape == (10, 3)
+
+
+@pytest.mark.parametrize(("C", "R", "phrase"), [
+    (C2[:1], R2, r"R has shape \(2, 2\); for 1 sensor \(the columns of y, shape \(10, 1\)\) it "
+                 r"must be \(1, 1\): one row and column per sensor \(for vision alone, "
+                 r"R\[:1, :1\]\)"),
+    (C2, R2[:1, :1], r"C has shape \(2, 3\); for 1 sensor .* it must be \(1, 3\): one row per "
+                     r"sensor \(for vision alone, C\[:1\] with y\[:, :1\]\)"),
+    (C2, R2, r"C has shape \(2, 3\)"),       # both kept: numpy alone would run on silently
+])
+def test_a_vision_only_run_with_both_senses_c_or_r_is_named(loaded, C, R, phrase):
+    with pytest.raises(StudentCodeError, match=f"^my_filter was given inputs that do not fit: "
+                                               f"{phrase}"):
+        call(loaded, Y2[:, :1], C, R)
+
+
+def test_the_silent_broadcast_the_guard_prevents_is_real():
+    """Unguarded, the same loop runs on the mismatched inputs without an error."""
+    namespace = {"np": np}
+    exec(SAVED_FILTER, namespace)
+    assert call(namespace["my_filter"], Y2[:, :1], C2, R2).shape == (10, 3)
+
+
+@pytest.mark.parametrize(("arguments", "phrase"), [
+    ((Y2[:, 0], A, C2[:1], np.eye(3), R2[:1, :1], np.zeros(3), np.eye(3)),
+     r"y has shape \(10,\); it must be \(n, m\)"),
+    ((Y2, np.eye(2), C2, np.eye(3), R2, np.zeros(3), np.eye(3)), r"C has shape \(2, 3\)"),
+    ((Y2, A, C2, np.eye(3), R2, np.zeros(2), np.eye(3)), r"z0 has shape \(2,\)"),
+    ((Y2, A, C2, np.eye(3), R2, np.zeros(3), np.eye(2)), r"P0 has shape \(2, 2\)"),
+    ((Y2, A[:2], C2, np.eye(3), R2, np.zeros(3), np.eye(3)), r"A has shape \(2, 3\)"),
+])
+def test_each_input_of_the_filter_is_named(arguments, phrase):
+    assert re.match(phrase, filter_inputs_problem(*arguments))
+
+
+@pytest.mark.parametrize(("arguments", "phrase"), [
+    ((np.zeros((5, 3)), A, 2), None),
+    ((np.zeros(5), A, 2), "estimates has shape (5,); it must be (n, k)"),
+    ((np.zeros((5, 3)), np.eye(2), 2), "A has shape (2, 2); for estimates of 3 states"),
+    ((np.zeros((5, 3)), A, 0.1), "delay_steps is 0.1; it must be a whole number of samples"),
+    ((np.zeros((5, 3)), A, 5), "delay_steps is 5; it must be a whole number"),
+    ((np.zeros((5, 3)), A, True), "delay_steps is True"),
+])
+def test_each_input_of_compensate_is_named(arguments, phrase):
+    problem = compensate_inputs_problem(*arguments)
+    assert problem == phrase if phrase is None else problem.startswith(phrase)
