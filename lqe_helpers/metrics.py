@@ -59,10 +59,11 @@ def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.n
     if truth.ndim != 1:
         raise ValueError(f"truth must have shape (n,), got shape {truth.shape}")
     if estimate.ndim < 1 or estimate.shape[-1] != truth.shape[-1]:
+        columns = estimate.ndim >= 2 and estimate.shape[-2] == truth.shape[-1]
         raise ValueError(
-            f"estimate must have shape (..., n) with n = {truth.shape[-1]} like truth, "
-            f"got shape {estimate.shape}"
-        )
+            f"estimate must have shape (..., n) with n = {truth.shape[-1]} like truth, got shape "
+            f"{estimate.shape}" + ("; estimates (n, k) hold one column per state: pass the "
+                                   "positions, column 0 ([:, 0])" if columns else ""))
     n_steps = truth.shape[-1]
     burn_in_steps = validation.count("burn_in_steps", burn_in_steps, 0, n_steps - 1)
     kept = estimate[..., burn_in_steps:]

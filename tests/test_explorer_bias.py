@@ -64,7 +64,8 @@ def check_numbers(numbers: str, values: dict[str, float], noise: np.ndarray) -> 
     final, std = expected.estimates[-1, 2], np.sqrt(expected.estimate_covariances[-1, 2, 2])
     # ± 2σ to two significant figures, b̂ to as many decimals.
     decimals = 1 - math.floor(math.log10(2 * std))
-    assert f"estimate at {end}: {final:.{decimals}f} ± {2 * std:.{decimals}f} cm/s²" in numbers
+    assert (f"estimate at {end} (± 2σ): {final:.{decimals}f} ± {2 * std:.{decimals}f} cm/s²"
+            in numbers)
     skip = DEFAULT.burn_in_steps
     mse = np.mean((expected.estimates[skip:, 0] - truth[skip:]) ** 2)
     alone = direct_vision_only(values["sigma_v"], noise)

@@ -23,6 +23,14 @@ def test_mse_refuses_nan_after_burn_in() -> None:
     assert metrics.mse(estimate, np.zeros(4), burn_in_steps=2) == 1.0
 
 
+def test_mse_of_whole_state_estimates_names_the_position_column() -> None:
+    # A student's (n, 3) estimates passed where the positions (n,) belong.
+    with pytest.raises(ValueError, match=r"got shape \(6, 3\); .*positions, column 0"):
+        metrics.mse(np.zeros((6, 3)), np.zeros(6))
+    with pytest.raises(ValueError, match=r"got shape \(5,\)$"):
+        metrics.mse(np.zeros(5), np.zeros(6))
+
+
 @pytest.mark.parametrize("df", [*range(1, 31), 31, 50, 299, 10_000])
 def test_t_critical_matches_scipy(df: int) -> None:
     # The table holds 4 decimals (rounding error <= 5e-5); above it the docstring

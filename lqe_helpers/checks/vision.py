@@ -403,7 +403,7 @@ def check_vision_difference(improvement: dict[float, metrics.Interval]) -> None:
                 f"improvement[{sigma:g}] is over {len(SIGMAS_V)} values, a row of mse_raw and "
                 f"mse_est (one run at both noise levels): rows and columns are mixed up. Row r "
                 f"is run r, column i is σ_v = {SIGMAS_V[0]:g} or {SIGMAS_V[1]:g} cm: take the "
-                f"column of this σ_v, all {DEFAULT.mc_runs} runs (mse_raw[:, i])")
+                f"column of this σ_v, all {DEFAULT.mc_runs} runs")
         raw, filtered = runs["raw"][:, column], runs["filtered"][:, column]
         other = runs["raw"][:, 1 - column] - runs["filtered"][:, 1 - column]
         mistakes = {

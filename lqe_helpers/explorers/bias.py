@@ -240,8 +240,8 @@ def _bias_numbers(tracking: bias_model.InputTracking, vision_mse: float) -> str:
     end_error = float(tracking.dead_reckoning[-1, 0] - tracking.truth[-1, 0])
     estimate = _plus_minus(float(tracking.bias_estimates[-1]), 2 * float(tracking.bias_stds[-1]))
     return (f"The pack's filter with the signal as input (bias_model). True bias "
-            f"b = {tracking.bias:g} cm/s²; its estimate at {scenario.duration:g} s: {estimate} "
-            f"cm/s². MSE of the filtered position after {scenario.burn_in:g} s: "
+            f"b = {tracking.bias:g} cm/s²; its estimate at {scenario.duration:g} s (± 2σ): "
+            f"{estimate} cm/s². MSE of the filtered position after {scenario.burn_in:g} s: "
             f"{float(tracking.mse()):.3g} cm² (vision-only filter on the same camera noise: "
             f"{vision_mse:.3g} cm²); dead reckoning ends {end_error:+.0f} cm off the path at "
             f"{scenario.duration:g} s.")

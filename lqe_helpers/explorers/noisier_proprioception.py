@@ -255,7 +255,7 @@ def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFA
             f"true position, the vision-only and the fused estimate ({whose(filter)}), and their "
             f"errors; right: the fused filter's steady-state position variance against σ_p "
             f"(the pack's steady state, which does not depend on the readings), with "
-            f"σ_p = {sigma_p:.1f} cm marked, below the vision-only level.")
+            f"the vision-only filter's level as a line and σ_p = {sigma_p:.1f} cm marked.")
 
 
 def explore_noisier_proprioception(scenario: Scenario = DEFAULT, *,

@@ -45,6 +45,15 @@ def filter_inputs_problem(y: object, A: object, C: object, Q: object, R: object,
         return f"A has shape {shapes['A']}; it must be square, (k, k) for k states"
     k = shapes["A"][0]
     sensors = f"{m} sensor{'s' * (m != 1)} (the columns of y, shape {shapes['y']})"
+    rows_of_c, r_shape = shapes["C"][:1], shapes["R"]
+    if (m == shapes["y"][0] > 1 and len(r_shape) == 2 and rows_of_c == r_shape[:1]
+            and r_shape[0] != m):
+        # C and R agree on the sensors; y is square, the mark of an (n,) array added to
+        # an (n, 1) one, which numpy broadcasts to (n, n).
+        return (f"y has shape {shapes['y']}, one column per time step, while C and R are "
+                f"for {r_shape[0]} sensor{'s' * (r_shape[0] != 1)}: y must be "
+                f"(n, {r_shape[0]}). An (n,) array added to an (n, 1) one makes (n, n): "
+                f"make both (n, 1) before adding")
     if shapes["C"] != (m, k):
         cut = " (for vision alone, C[:1] with y[:, :1])" if m == 1 else ""
         return (f"C has shape {shapes['C']}; for {sensors} and {k} states it must be "
