@@ -7,27 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from . import validation
-from .distributions import chi2_quantile
-
-# Two-sided 95 % Student-t critical values t(0.975, df) for df = 1 … 30.
-_T975 = (12.7062, 4.3027, 3.1824, 2.7764, 2.5706, 2.4469, 2.3646, 2.3060, 2.2622, 2.2281,
-         2.2010, 2.1788, 2.1604, 2.1448, 2.1314, 2.1199, 2.1098, 2.1009, 2.0930, 2.0860,
-         2.0796, 2.0739, 2.0687, 2.0639, 2.0595, 2.0555, 2.0518, 2.0484, 2.0452, 2.0423)
-_Z975 = 1.959963984540054
-
-
-def t_critical_95(df: int) -> float:
-    """Two-sided 95 % critical value of Student's t with ``df`` degrees of freedom.
-
-    Exact (4 decimals) for df <= 30; above, the Cornish–Fisher expansion around the
-    normal quantile, accurate to 1e-5.
-    """
-    df = validation.count("df", df, minimum=1)
-    if df <= len(_T975):
-        return _T975[df - 1]
-    z = _Z975
-    return (z + (z**3 + z) / (4 * df) + (5 * z**5 + 16 * z**3 + 3 * z) / (96 * df**2)
-            + (3 * z**7 + 19 * z**5 + 17 * z**3 - 15 * z) / (384 * df**3))
+from .distributions import chi2_quantile, t_critical_95  # t_critical_95: metrics.t_critical_95 too
 
 
 def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.ndarray:
@@ -60,10 +40,9 @@ def mse(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int = 0) -> np.n
         raise ValueError(f"truth must have shape (n,), got shape {truth.shape}")
     if estimate.ndim < 1 or estimate.shape[-1] != truth.shape[-1]:
         columns = estimate.ndim >= 2 and estimate.shape[-2] == truth.shape[-1]
-        raise ValueError(
-            f"estimate must have shape (..., n) with n = {truth.shape[-1]} like truth, got shape "
-            f"{estimate.shape}" + ("; estimates (n, k) hold one column per state: pass the "
-                                   "positions, column 0 ([:, 0])" if columns else ""))
+        hint = "; estimates (n, k) hold one column per state: pass column 0, the positions"
+        raise ValueError(f"estimate must have shape (..., n) with n = {truth.shape[-1]} like "
+                         f"truth, got shape {estimate.shape}" + (hint if columns else ""))
     n_steps = truth.shape[-1]
     burn_in_steps = validation.count("burn_in_steps", burn_in_steps, 0, n_steps - 1)
     kept = estimate[..., burn_in_steps:]
@@ -108,7 +87,12 @@ class Interval:
     def __sub__(self, other: object) -> Interval:
         raise TypeError("intervals cannot be subtracted: the difference of two conditions is "
                         "mean_ci95 of their per-run differences (paired, run by run)")
-    __rsub__ = __sub__
+
+    def __truediv__(self, other: object) -> Interval:
+        raise TypeError("intervals cannot be divided: a share or ratio of two conditions is "
+                        "mean_ci95 of the per-run ratios (run by run)")
+
+    __rsub__, __rtruediv__ = __sub__, __truediv__
 
 
 def mean_ci95(samples: np.ndarray) -> Interval:
@@ -158,7 +142,7 @@ def convergence_time(squared_error: np.ndarray, dt: float, factor: float = 2.0) 
     Parameters
     ----------
     squared_error : array_like, shape (..., n)
-        Squared error (cm²) per sample, e.g. a Monte Carlo mean.
+        Squared error (cm²) per sample, e.g. a Monte Carlo mean; n >= 10.
     dt : float
         Time step in s.
     factor : float
@@ -170,8 +154,9 @@ def convergence_time(squared_error: np.ndarray, dt: float, factor: float = 2.0) 
         Convergence time in s (0 if the curve never leaves the band).
     """
     curve = validation.finite_array("squared_error", squared_error, min_ndim=1)
-    if curve.shape[-1] < 2:
-        raise ValueError(f"squared_error needs at least 2 samples, got shape {curve.shape}")
+    if curve.shape[-1] < 10:  # the steady level is a mean over the second half
+        raise ValueError(f"squared_error needs at least 10 samples along its last axis (time), "
+                         f"got shape {curve.shape}: was the mean taken over the right axis?")
     if np.any(curve < 0):
         raise ValueError("squared_error must be >= 0, got negative values")
     dt = validation.positive("dt", dt, "s")

@@ -35,8 +35,8 @@ def test_check_fusion_passes_the_worked_solution(capsys) -> None:
      "row 1 (proprioception) is [0.0, 1.0, 0.0], which reads velocity v"),
     (C_FUSED, np.diag([1.5, 4.5]), "R holds the standard deviations"),
     (C_FUSED, np.diag([20.25, 2.25]), "R's rows are swapped"),
-    (C_FUSED, np.diag([2.25, 4.5]), "R's proprioception entry holds σ = 4.5 cm, not the "
-                                    "variance σ² = 20.25 cm²"),
+    (C_FUSED, np.diag([2.25, 4.5]), "R's proprioception entry holds σ = 4.5 cm, not its "
+                                    "variance σ² (cm²)"),
     (C_FUSED, np.diag([1.5, 20.25]), "R's vision entry holds σ = 1.5 cm"),
     (C_FUSED, np.array([[2.25, 6.75], [6.75, 20.25]]), "R has off-diagonal entries"),
     (C_FUSED, np.array([2.25, 20.25]), "R has shape (2,): a vector"),

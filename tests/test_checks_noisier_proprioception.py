@@ -69,8 +69,7 @@ def test_check_noisier_sense_passes_the_worked_answer(capsys) -> None:
     ("sigmas in R", "R holds the standard deviations σ_v = 1.5 and σ_p = 4.5 cm"),
     ("variance times three", "R's proprioceptive variance is three times vision's"),
     ("swapped", "R's rows are swapped"),
-    ("sigma_p in R", "R's proprioception entry holds σ = 4.5 cm, not the variance σ² = "
-                     "20.25 cm²"),
+    ("sigma_p in R", "R's proprioception entry holds σ = 4.5 cm, not its variance σ² (cm²)"),
 ])
 def test_check_noisier_sense_names_the_cause(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_noisier_sense, *task1(slip))

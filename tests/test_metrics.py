@@ -25,7 +25,7 @@ def test_mse_refuses_nan_after_burn_in() -> None:
 
 def test_mse_of_whole_state_estimates_names_the_position_column() -> None:
     # A student's (n, 3) estimates passed where the positions (n,) belong.
-    with pytest.raises(ValueError, match=r"got shape \(6, 3\); .*positions, column 0"):
+    with pytest.raises(ValueError, match=r"got shape \(6, 3\); .*pass column 0, the positions"):
         metrics.mse(np.zeros((6, 3)), np.zeros(6))
     with pytest.raises(ValueError, match=r"got shape \(5,\)$"):
         metrics.mse(np.zeros(5), np.zeros(6))
@@ -93,11 +93,13 @@ def test_convergence_time_interval_brackets_the_estimate() -> None:
             r"burn_in_steps must be a whole number in \[0, 3\], got 4",
         ),
         (
-            lambda: metrics.convergence_time(np.ones(5), 0.1, factor=1.0),
+            lambda: metrics.convergence_time(np.ones(10), 0.1, factor=1.0),
             "factor must be > 1, got 1.0",
         ),
-        (lambda: metrics.convergence_time(-np.ones(5), 0.1), "squared_error must be >= 0"),
-        (lambda: metrics.convergence_time(np.ones(5), 0.0), "dt must be a finite number > 0 s"),
+        (lambda: metrics.convergence_time(-np.ones(10), 0.1), "squared_error must be >= 0"),
+        (lambda: metrics.convergence_time(np.ones((300, 2)), 0.1),
+         r"at least 10 samples along its last axis \(time\), got shape \(300, 2\)"),
+        (lambda: metrics.convergence_time(np.ones(10), 0.0), "dt must be a finite number > 0 s"),
         (
             lambda: metrics.convergence_time_ci95(np.ones((1, 5)), 0.1, np.random.default_rng(0)),
             "runs >= 2",
@@ -182,3 +184,11 @@ def test_two_intervals_cannot_be_subtracted_the_runs_are_paired_first() -> None:
         first - first
     with pytest.raises(TypeError, match="intervals cannot be subtracted"):
         1.0 - first
+
+
+def test_intervals_cannot_be_divided() -> None:
+    a = metrics.mean_ci95(np.array([1.0, 2.0, 3.0]))
+    for divide in (lambda: a / a, lambda: a / 2.0, lambda: 2.0 / a):
+        with pytest.raises(TypeError, match="intervals cannot be divided: a share or ratio of "
+                                            "two conditions is mean_ci95 of the per-run ratios"):
+            divide()

@@ -90,13 +90,17 @@ def test_each_input_of_the_filter_is_named(arguments, phrase):
 def test_readings_broadcast_to_n_by_n_are_named_not_c(loaded):
     """Trial 3: truth (n,) + σ noise (n, 1) made y (n, n); the guard blamed C, not y."""
     truth, noise = np.arange(10.0), np.ones((10, 1))
-    with pytest.raises(StudentCodeError, match=r"y has shape \(10, 10\), one column per time "
-                                               r"step, while C and R are for 1 sensor: y must "
-                                               r"be \(n, 1\)\. An \(n,\) array added"):
-        call(loaded, truth + 1.5 * noise, C2[:1], R2[:1, :1])
-    # Square readings of a true m-sensor run (n = m) keep the C message: C and R disagree.
+    for R in (R2[:1, :1], 2.25):   # R right, or a number where (1, 1) belongs
+        with pytest.raises(StudentCodeError, match=r"y has shape \(10, 10\), one column per "
+                                                   r"time step, while C is for 1 sensor: y "
+                                                   r"must be \(n, 1\)\. An \(n,\) array"):
+            call(loaded, truth + 1.5 * noise, C2[:1], R)
+    # A run of as few steps as sensors (n = m <= 3) keeps the C message.
     assert filter_inputs_problem(np.zeros((2, 2)), A, C2[:1], np.eye(3), R2, np.zeros(3),
                                  np.eye(3)).startswith("C has shape (1, 3)")
+    # A number for R with vision's one column: no hint about cutting both senses' R.
+    assert filter_inputs_problem(Y2[:, :1], A, C2[:1], np.eye(3), 2.25, np.zeros(3),
+                                 np.eye(3)).endswith("one row and column per sensor")
 
 
 @pytest.mark.parametrize(("arguments", "phrase"), [

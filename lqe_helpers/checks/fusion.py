@@ -159,8 +159,8 @@ def judge_noise_matrix(R: np.ndarray, sigma_v: float, sigma_p: float) -> None:
         mixed[entry] = sigmas[entry]
         if same(diag, mixed):
             raise CheckFailed(
-                f"R's {label} entry holds σ = {sigmas[entry]:g} cm, not the variance σ² = "
-                f"{variances[entry]:g} cm²: R is a covariance, its diagonal holds variances")
+                f"R's {label} entry holds σ = {sigmas[entry]:g} cm, not its variance σ² "
+                f"(cm²): R is a covariance, its diagonal holds variances")
     if same(diag, variances[::-1]):
         raise CheckFailed(
             "R's rows are swapped: row 0 must be vision's variance and row 1 "

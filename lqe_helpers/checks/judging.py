@@ -193,7 +193,10 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
             f"are not those of metrics.mean_ci95 of the per-run values"
             + (": it is much wider than the paired interval. Are the runs paired, run r "
                "with run r (the same noise draw), in their order, before taking the interval "
-               "of the differences?" if wider else ""))
+               "of the differences?" if wider else
+               ": give mean_ci95 the per-run values themselves (for a difference, run r − run "
+               "r of the other, on the same noise draw), not values combined with a mean "
+               "first"))
     raise CheckFailed(
         f"{name} (mean {got[0]:.6g}{unit_text}) does not match {what} (to "
         f"{tolerance_text(rtol)} relative), and not by one of the usual mistakes")

@@ -45,21 +45,21 @@ def filter_inputs_problem(y: object, A: object, C: object, Q: object, R: object,
         return f"A has shape {shapes['A']}; it must be square, (k, k) for k states"
     k = shapes["A"][0]
     sensors = f"{m} sensor{'s' * (m != 1)} (the columns of y, shape {shapes['y']})"
-    rows_of_c, r_shape = shapes["C"][:1], shapes["R"]
-    if (m == shapes["y"][0] > 1 and len(r_shape) == 2 and rows_of_c == r_shape[:1]
-            and r_shape[0] != m):
-        # C and R agree on the sensors; y is square, the mark of an (n,) array added to
-        # an (n, 1) one, which numpy broadcasts to (n, n).
-        return (f"y has shape {shapes['y']}, one column per time step, while C and R are "
-                f"for {r_shape[0]} sensor{'s' * (r_shape[0] != 1)}: y must be "
-                f"(n, {r_shape[0]}). An (n,) array added to an (n, 1) one makes (n, n): "
-                f"make both (n, 1) before adding")
+    rows_of_c = shapes["C"][0] if len(shapes["C"]) == 2 else None
+    if m == shapes["y"][0] > 3 and rows_of_c is not None and rows_of_c != m:
+        # y is square while C has another number of sensors: the mark of an (n,) array
+        # added to an (n, 1) one, which numpy broadcasts to (n, n).
+        return (f"y has shape {shapes['y']}, one column per time step, while C is for "
+                f"{rows_of_c} sensor{'s' * (rows_of_c != 1)}: y must be (n, {rows_of_c}). An "
+                f"(n,) array added to an (n, 1) one makes (n, n): make both (n, 1) first")
     if shapes["C"] != (m, k):
-        cut = " (for vision alone, C[:1] with y[:, :1])" if m == 1 else ""
+        cut = (" (for vision alone, C[:1] with y[:, :1])"
+               if m == 1 and len(shapes["C"]) == 2 and shapes["C"][0] > 1 else "")
         return (f"C has shape {shapes['C']}; for {sensors} and {k} states it must be "
                 f"({m}, {k}): one row per sensor{cut}")
     if shapes["R"] != (m, m):
-        cut = " (for vision alone, R[:1, :1])" if m == 1 else ""
+        cut = (" (for vision alone, R[:1, :1])"
+               if m == 1 and len(shapes["R"]) == 2 and shapes["R"][0] > 1 else "")
         return (f"R has shape {shapes['R']}; for {sensors} it must be ({m}, {m}): one row and "
                 f"column per sensor{cut}")
     for name, needed in (("Q", (k, k)), ("P0", (k, k)), ("z0", (k,))):
