@@ -181,7 +181,16 @@ def eyes_closed(*, mistake=""):
 
 def test_check_eyes_closed_passes_the_worked_solution(capsys):
     line = assert_passes(capsys, checks.check_eyes_closed, predict_covariance, *eyes_closed())
-    assert "P_close" in line and "1e-9" in line
+    assert "P_close" in line and "1e-9" in line and "crossing" in line
+
+
+def test_check_eyes_closed_without_crossing_judges_the_band_only(capsys):
+    """Notebook 00 computes the crossing in a given cell: the check takes the band alone."""
+    two_sigma, _ = eyes_closed()
+    line = assert_passes(capsys, checks.check_eyes_closed, predict_covariance, two_sigma)
+    assert "two_sigma matches the band" in line and "crossing" not in line
+    assert_fails("it is σ, not 2σ", checks.check_eyes_closed, predict_covariance,
+                 eyes_closed(mistake="one sigma")[0])
 
 
 @pytest.mark.parametrize(("mistake", "phrase"), [

@@ -391,69 +391,6 @@ def test_check_vision_trial_without_a_function_or_before_it_is_written() -> None
     assert_fails("vision_trial is not written yet", checks.check_vision_trial, vision_trial)
 
 
-# ------------------------------------------------------------------------------------------
-# check_vision_difference (Task 3)
-# ------------------------------------------------------------------------------------------
-
-
-def task3(slip: str = "") -> dict:
-    """Task 3 as a student writes it (the notebook's worked code), with one ``slip``."""
-    batch = experiments.track(DEFAULT, sigmas=[[1.5], [4.5]], runs=DEFAULT.mc_runs)
-    mse_raw, mse_est = batch.measurement_mse("vision"), batch.mse()
-    if slip == "whole trial":
-        mse_raw = metrics.mse(batch.measurements[..., 0], TRUTH)
-        mse_est = metrics.mse(batch.positions, TRUTH)
-    improvement = {}
-    for i, sigma_v in enumerate((1.5, 4.5)):
-        column = 1 - i if slip == "columns swapped" else i
-        raw, est = mse_raw[:, column], mse_est[:, column]
-        if slip == "reversed":
-            improvement[sigma_v] = metrics.mean_ci95(est - raw)
-        elif slip == "ratio":
-            improvement[sigma_v] = metrics.mean_ci95(raw / est)
-        elif slip == "separate intervals":
-            a, b = metrics.mean_ci95(raw), metrics.mean_ci95(est)
-            improvement[sigma_v] = metrics.Interval(a.mean - b.mean, a.low - b.high,
-                                                    a.high - b.low, a.runs)
-        elif slip == "difference of means":
-            improvement[sigma_v] = raw.mean() - est.mean()
-        elif slip == "rows":                        # row i (one run, both σ_v), not column i
-            improvement[sigma_v] = metrics.mean_ci95(mse_raw[i] - mse_est[i])
-        else:
-            improvement[sigma_v] = metrics.mean_ci95(raw - est)
-    return improvement
-
-
-def test_check_vision_difference_passes_the_worked_answer(capsys) -> None:
-    line = assert_passes(capsys, checks.check_vision_difference, task3())
-    assert "paired over 300 runs at σ_v = 1.5 and 4.5 cm" in line
-
-
-@pytest.mark.parametrize(("slip", "phrase"), [
-    ("reversed", "improvement[1.5] is not right: the sign is reversed"),
-    ("whole trial", "the MSEs are those of the whole trial"),
-    ("columns swapped", "improvement[1.5] is not right: it is the value for σ_v = 4.5 cm"),
-    ("ratio", "it is the interval of the ratio raw / filtered"),
-    ("separate intervals", "it combines the two separate intervals"),
-    ("difference of means", "improvement[1.5] is a number; it must be the metrics.Interval"),
-    ("rows", "improvement[1.5] is over 2 values, a row of mse_raw and mse_est (one run at both "
-             "noise levels): rows and columns are mixed up"),
-])
-@pytest.mark.slow
-def test_check_vision_difference_names_the_cause(slip: str, phrase: str) -> None:
-    assert_fails(phrase, checks.check_vision_difference, task3(slip))
-
-
-def test_check_vision_difference_judges_against_the_engine_not_the_students_arrays() -> None:
-    """A self-consistent interval of the wrong runs (another seed) does not pass."""
-    other = scenario.Scenario(seed=DEFAULT.seed + 1)
-    batch = experiments.track(other, sigmas=[[1.5], [4.5]], runs=DEFAULT.mc_runs)
-    raw, est = batch.measurement_mse("vision"), batch.mse()
-    improvement = {s: metrics.mean_ci95(raw[:, i] - est[:, i]) for i, s in enumerate((1.5, 4.5))}
-    assert_fails("does not match the paired difference raw − filtered MSE recomputed",
-                 checks.check_vision_difference, improvement)
-
-
 def test_check_vision_needs_no_student_function_and_leaves_the_engine_alone() -> None:
     """Number checks call no student code; the engine's draw is the scenario's own."""
     noise = DEFAULT.unit_noise(sensors=("vision",))

@@ -229,8 +229,9 @@ def test_handouts_of_a_one_megabyte_line_are_built_in_seconds(tmp_path):
 
 # --- --timeout and SIGTERM end a run with one line ------------------------------------------------
 
-ENDLESS = ("import os, time\nopen('kernel.pid', 'w').write(str(os.getpid()))\n"
-           "while True:\n    time.sleep(0.1)")
+# The pid file appears whole (written aside, then renamed), so the test never reads it empty.
+ENDLESS = ("import os, time\nopen('kernel.pid.part', 'w').write(str(os.getpid()))\n"
+           "os.replace('kernel.pid.part', 'kernel.pid')\nwhile True:\n    time.sleep(0.1)")
 
 
 @pytest.mark.kernel

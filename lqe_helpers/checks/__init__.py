@@ -107,7 +107,7 @@ from .noisier_proprioception_further import (
     check_proprioception_sweep,
     check_sweep_reading,
 )
-from .vision import check_filter, check_vision_difference, check_vision_trial
+from .vision import check_filter, check_vision_trial
 from .vision_further import (
     check_nis,
     check_sampling_ratio,
@@ -184,7 +184,6 @@ __all__ = [
     "check_systematic_error",
     "check_transition_matrix",
     "check_uncertainty_growth",
-    "check_vision_difference",
     "check_vision_trial",
     "check_white_jerk",
 ]

@@ -4,12 +4,10 @@
   against the pack's engine (:func:`lqe_helpers.filter.kalman_filter`);
 - :func:`check_vision_trial` (Task 2): the student's ``vision_trial(sigma_v)``, the readings
   and the estimates of one trial at σ_v = 1.5 and 4.5 cm, against the engine on the
-  scenario's draw;
-- :func:`check_vision_difference` (Task 3): the paired raw − filtered difference over
-  the Monte Carlo runs, recomputed with :func:`lqe_helpers.experiments.track`.
+  scenario's draw.
 
-:func:`monte_carlo` (Task 3's runs) and :func:`keyed` (a student's dict keyed by σ_v or
-Δt) serve the Going further checks too (:mod:`~lqe_helpers.checks.vision_smoothers`,
+:func:`monte_carlo` (the core path's Monte Carlo runs) and :func:`keyed` (a student's dict
+keyed by σ_v or Δt) serve the Going further checks (:mod:`~lqe_helpers.checks.vision_smoothers`,
 :mod:`~lqe_helpers.checks.vision_further`).
 """
 
@@ -21,15 +19,14 @@ from collections.abc import Callable
 
 import numpy as np
 
-from .. import experiments, metrics, simulation
+from .. import experiments, simulation
 from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
 from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import judge
 from .machinery import (
     FUNCTION_RTOL,
-    INTERVAL_RTOL,
     STOP_CALLING,
     CheckFailed,
     call_student,
@@ -181,7 +178,7 @@ def _filter_output(output: object, name: str, m: FilterCase) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------
-# A student's dict keyed by σ_v (Task 3, and the Going further checks)
+# A student's dict keyed by σ_v (the Going further checks)
 # ------------------------------------------------------------------------------------------
 
 def keyed(values: object, name: str, what: str, keys: tuple[float, ...] = SIGMAS_V,
@@ -347,79 +344,15 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
 
 
 # ------------------------------------------------------------------------------------------
-# Task 3: many runs, paired
+# The core path's Monte Carlo runs (the notebook's given batch)
 # ------------------------------------------------------------------------------------------
 
 @functools.cache
 def monte_carlo() -> experiments.Tracking:
-    """Task 3's runs: ``DEFAULT.mc_runs`` runs at σ_v = 1.5 and 4.5 cm, shape (runs, 2, ...).
+    """The core path's runs: ``DEFAULT.mc_runs`` runs at σ_v = 1.5 and 4.5 cm, shape (runs, 2, ...).
 
     The engine's batch of the scenario's draws, the same as the notebook's ``batch``;
     computed once and shared by the checks of notebook 01 (none hands it to a student's
     function).
     """
     return experiments.track(DEFAULT, sigmas=[[s] for s in SIGMAS_V], runs=DEFAULT.mc_runs)
-
-
-@functools.cache
-def _monte_carlo_mses() -> dict[str, np.ndarray]:
-    """Per-run MSEs (runs, 2) of the readings and estimates at both σ_v (cm², read-only)."""
-    batch = monte_carlo()
-    truth = DEFAULT.truth[:, 0]
-    values = {"raw": batch.measurement_mse("vision"), "filtered": batch.mse(),
-              "raw_whole": metrics.mse(batch.measurements[..., 0], truth),
-              "filtered_whole": metrics.mse(batch.positions, truth)}
-    for array in values.values():
-        array.setflags(write=False)
-    return values
-
-
-def check_vision_difference(improvement: dict[float, metrics.Interval]) -> None:
-    """Check Task 3's paired differences raw − filtered MSE over the Monte Carlo runs.
-
-    Recomputed from the task's inputs before looking at the student's: ``DEFAULT.mc_runs``
-    runs at σ_v = 1.5 and 4.5 cm (:func:`lqe_helpers.experiments.track`), per-run MSEs
-    after the burn-in, and ``metrics.mean_ci95`` of the per-run differences; mean and
-    ends must agree within :data:`INTERVAL_RTOL` of the interval's scale.
-
-    Parameters
-    ----------
-    improvement : dict of float to metrics.Interval
-        The student's intervals keyed by σ_v (cm).
-
-    Raises
-    ------
-    CheckFailed
-        Naming the entry and the likely cause: a row (one run) taken for a column, the
-        sign reversed, an unpaired interval, the whole trial, the other noise level, a
-        ratio instead of a difference, one MSE alone, the standard deviation for the
-        standard error, ...
-    """
-    intervals = keyed(improvement, "improvement", "paired intervals (metrics.Interval)")
-    runs = _monte_carlo_mses()
-    for column, sigma in enumerate(SIGMAS_V):
-        if getattr(intervals[sigma], "runs", None) == len(SIGMAS_V) != DEFAULT.mc_runs:
-            raise CheckFailed(
-                f"improvement[{sigma:g}] is over {len(SIGMAS_V)} values, a row of mse_raw and "
-                f"mse_est (one run at both noise levels): rows and columns are mixed up. Row r "
-                f"is run r, column i is σ_v = {SIGMAS_V[0]:g} or {SIGMAS_V[1]:g} cm: take the "
-                f"column of this σ_v, all {DEFAULT.mc_runs} runs")
-        raw, filtered = runs["raw"][:, column], runs["filtered"][:, column]
-        other = runs["raw"][:, 1 - column] - runs["filtered"][:, 1 - column]
-        mistakes = {
-            **interval_mistakes(raw, filtered, "the raw readings' MSE", "the filtered MSE"),
-            "the MSEs are those of the whole trial: leave out the burn-in in both":
-                metrics.mean_ci95(runs["raw_whole"][:, column]
-                                  - runs["filtered_whole"][:, column]),
-            f"it is the value for σ_v = {SIGMAS_V[1 - column]:g} cm": metrics.mean_ci95(other),
-            "it is the interval of the ratio raw / filtered; the task asks for the paired "
-            "difference raw − filtered": metrics.mean_ci95(raw / filtered),
-        }
-        judge_interval(f"improvement[{sigma:g}]", intervals[sigma],
-                       metrics.mean_ci95(raw - filtered), INTERVAL_RTOL, unit="cm²",
-                       what="the paired difference raw − filtered MSE recomputed from the "
-                            "task's inputs", mistakes=mistakes)
-    passed(f"raw − filtered MSE, paired over {DEFAULT.mc_runs} runs at σ_v = "
-           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm: mean and 95 % interval match the "
-           f"pack's engine on the scenario's draws to {tolerance_text(INTERVAL_RTOL)} "
-           f"relative")

@@ -9,7 +9,7 @@
 - :func:`check_sampling_ratio` (part 4): raw / filtered MSE at three time steps.
 
 Each recomputes the task's numbers from its own inputs and draws with the pack's engine
-(Task 3's batch, :func:`lqe_helpers.checks.vision.monte_carlo`) before looking at the
+(the core path's batch, :func:`lqe_helpers.checks.vision.monte_carlo`) before looking at the
 student's values.
 """
 
@@ -122,7 +122,7 @@ def check_systematic_error(amplitude: dict[float, float], lead_ms: dict[float, f
     Recomputed from the task's inputs before looking at the student's: the engine fed
     noise-free readings (which equals a correct ``my_filter``), the sine of the flight's
     frequency fitted after the burn-in (:func:`lqe_helpers.metrics.fit_sinusoid`), the
-    noise-free run's MSE, and the Monte Carlo mean square of Task 3's estimates minus the
+    noise-free run's MSE, and the Monte Carlo mean square of the core path's estimates minus the
     noise-free one after the burn-in; each within :data:`MSE_RTOL` relative.
 
     Parameters
@@ -204,7 +204,7 @@ def check_steady_state(forecast: dict[float, float], coverage: dict[float, float
     Recomputed from the task's inputs before looking at the student's: the steady state
     of eq. (5) with R = [[σ_v²]] (:func:`lqe_helpers.steady_state.steady_state` of
     :func:`lqe_helpers.experiments.filter_model`), and the
-    percentage of samples after the burn-in, over Task 3's runs, where |estimate −
+    percentage of samples after the burn-in, over the core path's runs, where |estimate −
     truth| <= 2 √(the filter's position variance); each within :data:`MSE_RTOL` relative.
 
     Parameters
@@ -224,7 +224,7 @@ def check_steady_state(forecast: dict[float, float], coverage: dict[float, float
               "coverage": keyed(coverage, "coverage", "percentages of samples")}
     _judge_each_sigma(values, {"forecast": "cm²", "coverage": "%"}, _confidence)
     passed(f"[P̂∞]pp and the ±2σ coverage at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} "
-           f"cm match the pack's steady state and engine on Task 3's runs to "
+           f"cm match the pack's steady state and engine on the core path's runs to "
            f"{tolerance_text(MSE_RTOL)} relative")
 
 
@@ -275,7 +275,7 @@ def check_nis(nis_mean: dict[float, float], runs_inside: dict[float, float]) -> 
     """Check part 3's NIS: its mean over runs and steps, and the share of runs in the band.
 
     Recomputed from the task's inputs before looking at the student's: the innovations of
-    Task 3's runs (:meth:`lqe_helpers.experiments.Tracking.innovations`), their NIS
+    the core path's runs (:meth:`lqe_helpers.experiments.Tracking.innovations`), their NIS
     (:func:`lqe_helpers.metrics.nis_test` after the burn-in), and the percentage of runs
     whose own mean NIS lies in ``metrics.nis_band(1, n − burn)``; each within
     :data:`MSE_RTOL` relative.
@@ -298,8 +298,8 @@ def check_nis(nis_mean: dict[float, float], runs_inside: dict[float, float]) -> 
               "runs_inside": keyed(runs_inside, "runs_inside", "percentages of runs")}
     _judge_each_sigma(values, {"nis_mean": "", "runs_inside": "%"}, _nis)
     passed(f"the mean NIS and the share of runs inside the 95 % band at σ_v = "
-           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match metrics.nis_test on Task 3's "
-           f"runs to {tolerance_text(MSE_RTOL)} relative")
+           f"{' and '.join(f'{s:g}' for s in SIGMAS_V)} cm match metrics.nis_test on the core "
+           f"path's runs to {tolerance_text(MSE_RTOL)} relative")
 
 
 # ------------------------------------------------------------------------------------------

@@ -264,7 +264,7 @@ def _grid(alphas: object) -> np.ndarray:
 
 @functools.lru_cache(maxsize=4)
 def _tuned(column: int, grid: tuple[float, ...], burn_in_steps: int) -> smoothing.TunedSmoother:
-    """The pack's tuned smoother on Task 3's readings at σ_v = SIGMAS_V[column].
+    """The pack's tuned smoother on the core path's readings at σ_v = SIGMAS_V[column].
 
     Kept for the four (column, burn-in) pairs of one grid only: the grid is the student's,
     and each result holds the smoothed runs (runs, n), so a cache of every grid a student
@@ -280,7 +280,7 @@ def check_smoother_comparison(best_alpha: dict[float, float],
                               alphas: np.ndarray) -> None:
     """Check the tuned smoother's weight and its paired difference with the LQE at both σ_v.
 
-    Recomputed from the task's inputs before looking at the student's: Task 3's
+    Recomputed from the task's inputs before looking at the student's: the core path's
     ``DEFAULT.mc_runs`` runs (the engine's, the same draws), every α of ``alphas``
     applied by :func:`lqe_helpers.smoothing.tune_smoother` to each run's readings, the α
     with the smallest Monte Carlo mean MSE after the burn-in (within :data:`MSE_RTOL`),
@@ -328,7 +328,7 @@ def check_smoother_comparison(best_alpha: dict[float, float],
         mistakes = {
             **interval_mistakes(tuned.mse, lqe, "the smoother's MSE", "the LQE's MSE"),
             "it compares the smoother with the raw readings; the task compares it with the "
-            "LQE's per-run MSEs (Task 3's mse_est)":
+            "LQE's per-run MSEs (the core path's mse_est)":
                 metrics.mean_ci95(tuned.mse - raw_mse[:, column]),
             "the smoother's MSEs are those of the whole trial: leave out the burn-in, as "
             "in the LQE's": metrics.mean_ci95(
@@ -345,7 +345,7 @@ def check_smoother_comparison(best_alpha: dict[float, float],
                             "inputs", mistakes=mistakes)
     passed(f"the best α on your grid and the paired difference smoother − LQE over "
            f"{DEFAULT.mc_runs} runs at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} cm "
-           f"match the pack's smoother and engine on Task 3's draws (α to "
+           f"match the pack's smoother and engine on the core path's draws (α to "
            f"{tolerance_text(MSE_RTOL)}, the interval to {tolerance_text(INTERVAL_RTOL)} "
            f"relative)")
 
