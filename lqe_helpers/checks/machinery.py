@@ -123,6 +123,31 @@ def call_student(function: Callable, *args: object, name: str, where: str,
     raise failure
 
 
+def answers_on_cases(cases: Sequence[object], call: Callable[[object], object],
+                     answer: Callable[[object, object], np.ndarray],
+                     ) -> tuple[dict[int, np.ndarray], dict[int, CheckFailed]]:
+    """A function check's random cases: ``call(case)`` (the student's function through
+    :func:`call_student`), then ``answer(output, case)`` (its output checked as an array).
+
+    Returns the answers and the call's failures, each by the case's index. A failure of
+    :data:`STOP_CALLING` (not written yet, timed out) stops at once, as does a CheckFailed
+    of ``answer`` (a wrong type or shape); any other failure of the call is kept, so that a
+    typical mistake can still be named from the other cases.
+    """
+    answers: dict[int, np.ndarray] = {}
+    errors: dict[int, CheckFailed] = {}
+    for index, case in enumerate(cases):
+        try:
+            output = call(case)
+        except STOP_CALLING:
+            raise
+        except CheckFailed as failure:
+            errors[index] = failure
+            continue
+        answers[index] = answer(output, case)
+    return answers, errors
+
+
 def student_result(value: object, *, name: str, what: str,
                    shape: Sequence[int | None] | None = None, allow_nan: bool = False,
                    where: str = "") -> np.ndarray:

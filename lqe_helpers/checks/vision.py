@@ -27,8 +27,8 @@ from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCas
 from .judging import judge
 from .machinery import (
     FUNCTION_RTOL,
-    STOP_CALLING,
     CheckFailed,
+    answers_on_cases,
     call_student,
     close,
     keyed_entries,
@@ -79,20 +79,12 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     name = require_callable(my_filter, "my_filter", "check_filter")
     models = filter_models.models()
     correct = {index: filter_models.right_estimates(index) for index in range(len(models))}
-    answers: dict[int, np.ndarray] = {}
-    errors: dict[int, CheckFailed] = {}
-    for index, m in enumerate(models):
-        try:
-            output = call_student(my_filter, *m.args, name=name, where=m.describe(),
-                                  arg_names=FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
-                                  forbid=(kalman_filter,))
-        except STOP_CALLING:
-            raise
-        except CheckFailed as failure:
-            errors[index] = failure
-            continue
-        answers[index] = _filter_output(output, name, m)
-
+    answers, errors = answers_on_cases(
+        models,
+        lambda m: call_student(my_filter, *m.args, name=name, where=m.describe(),
+                               arg_names=FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
+                               forbid=(kalman_filter,)),
+        lambda output, m: _filter_output(output, name, m))
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
         passed(f"{name} matches eq. (5) on {len(models)} random models (1–4 states, 1–3 "

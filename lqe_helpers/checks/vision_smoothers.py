@@ -25,8 +25,8 @@ from .machinery import (
     INTERVAL_RTOL,
     MSE_RTOL,
     SEED,
-    STOP_CALLING,
     CheckFailed,
+    answers_on_cases,
     argument_array,
     call_student,
     close,
@@ -181,20 +181,12 @@ def check_smoother(my_smoother: Callable[..., np.ndarray]) -> None:
     name = require_callable(my_smoother, "my_smoother", "check_smoother")
     cases = smoother_cases()
     correct = {index: _right(index) for index in range(len(cases))}
-    answers: dict[int, np.ndarray] = {}
-    errors: dict[int, CheckFailed] = {}
-    for index, case in enumerate(cases):
-        try:
-            output = call_student(my_smoother, *case.args(), name=name,
-                                  where=case.describe(), arg_names=_SMOOTHER_ARGS,
-                                  shape_hint=_SMOOTHER_SHAPE_HINT,
-                                  forbid=(smoothing.exponential_smoother,))
-        except STOP_CALLING:
-            raise
-        except CheckFailed as failure:
-            errors[index] = failure
-            continue
-        answers[index] = _smoother_output(output, name, case)
+    answers, errors = answers_on_cases(
+        cases,
+        lambda case: call_student(my_smoother, *case.args(), name=name, where=case.describe(),
+                                  arg_names=_SMOOTHER_ARGS, shape_hint=_SMOOTHER_SHAPE_HINT,
+                                  forbid=(smoothing.exponential_smoother,)),
+        lambda output, case: _smoother_output(output, name, case))
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
         passed(f"{name} matches s_j = s_(j−1) + α (y_j − s_(j−1)) from s_0 = y_0 on "
