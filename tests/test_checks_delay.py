@@ -33,6 +33,8 @@ def student_compensate(estimates, A, delay_steps, *, mistake: str = ""):
         ahead = np.linalg.matrix_power(A, d - 1)
     elif mistake == "no A":
         ahead = np.eye(k)
+    elif mistake == "A once":
+        ahead = A
     fill = 0.0 if mistake == "zeros before" else np.nan
     out = np.full((n, k), fill)
     if mistake == "no shift":
@@ -73,6 +75,7 @@ COMPENSATION_MISTAKES = {
     "only existing rows": "only the rows that exist",
     "slice from the end": "slices that count from the end",
     "row times matrix": "A^δ is applied from the wrong side",
+    "A once": "A is applied once, not δ times",
 }
 
 
@@ -208,7 +211,8 @@ def task2(slip: str = "") -> tuple:
     delayed = {"whole states": delayed_states, "not delayed": estimates[:, 0],
                "late readings": late_readings}.get(slip, delayed_states[:, column])
     source = delayed_states if slip == "compensate the delayed" else estimates
-    compensated = student_compensate(source, DEFAULT.A, steps)[:, column]
+    compensated = student_compensate(source, DEFAULT.A, steps,
+                                     mistake="A once" if slip == "A once" else "")[:, column]
     return late_readings, delayed, compensated
 
 
@@ -239,6 +243,7 @@ def test_task2_inputs_are_those_of_the_engine() -> None:
                     "filter made them"),
     ("truth seen late", "late_readings is not right: it holds the true position seen late"),
     ("velocity column", "delayed is not right: it holds velocities (column 1 of the states"),
+    ("A once", "compensated is not right: A is applied once, not δ times"),
     ("filter the late readings", "delayed is NaN at every sample, also after j = δ = 10: was "
                                  "your my_filter run on the late readings?"),
 ])
@@ -264,6 +269,15 @@ def test_check_delay_signals_catches_the_compensation_that_reverses_the_answer()
     assert mse(wrong) > 0.95 * mse(delayed) > 2 * mse(task2()[2])   # the benefit of (e) is gone
     assert_fails("given the delayed estimates", checks.check_delay_signals,
                  *task2("compensate the delayed"))
+
+
+def test_check_delay_signals_asks_about_the_compensation_not_my_filter() -> None:
+    """An unrecognised compensation is asked about A^δ and ẑ_(j−δ), not only my_filter."""
+    late, delayed, compensated = task2()
+    twisted = compensated + 0.5 * np.sin(np.arange(compensated.size))
+    message = assert_fails("compensated does not match the signal recomputed",
+                           checks.check_delay_signals, late, delayed, twisted)
+    assert "which power of A moves it (A^δ" in message
 
 
 def test_check_delay_signals_names_nan_in_the_wrong_places() -> None:
@@ -342,6 +356,10 @@ def task3(slip: str = "") -> tuple:
         won_back = metrics.mean_ci95((mse_delayed - mse_predicted) / mse_now)
     elif slip == "compensated over delayed":
         won_back = metrics.mean_ci95(mse_predicted / mse_delayed)
+    elif slip == "denominator reversed":
+        won_back = metrics.mean_ci95((mse_delayed - mse_predicted) / (mse_now - mse_delayed))
+    elif slip == "numerator reversed":
+        won_back = metrics.mean_ci95((mse_predicted - mse_delayed) / (mse_delayed - mse_now))
     elif slip == "names swapped":
         gain, won_back = won_back, gain
     return gain, won_back
@@ -370,6 +388,8 @@ def test_check_delay_difference_passes_the_worked_answer(capsys) -> None:
     ("divided by the undelayed MSE", "won_back is not right: it divides by the undelayed MSE"),
     ("compensated over delayed", "won_back is not right: it is compensated / delayed"),
     ("names swapped", "gain is not right: it is the share of the delay's cost won back"),
+    ("denominator reversed", "won_back is not right: one of its two differences is reversed"),
+    ("numerator reversed", "won_back is not right: one of its two differences is reversed"),
 ])
 @pytest.mark.slow
 def test_check_delay_difference_names_the_cause(slip: str, phrase: str) -> None:

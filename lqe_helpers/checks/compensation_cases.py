@@ -74,6 +74,7 @@ def mistaken(mistake: str, case: Case) -> np.ndarray | None:
         "power_plus_one": lambda: moved(d, power(d + 1)),
         "shift_minus_one": lambda: moved(d - 1, power(d)),
         "shift_plus_one": lambda: moved(d + 1, power(d)),
+        "single_A": lambda: moved(d, A),
         "times_delta": lambda: moved(d, d * A),
         "elementwise": lambda: moved(d, A**d),
         "no_shift": lambda: estimates @ power(d).T,
@@ -95,6 +96,10 @@ COMPENSATION_MISTAKES = {
     "shift_plus_one": (
         "off by one in the delay: your row j uses the estimate ẑ_(j−δ−1). Eq. (7) "
         "predicts from the estimate δ samples back, ẑ_(j−δ)"),
+    "single_A": (
+        "A is applied once, not δ times: your z*_j is A ẑ_(j−δ), one step ahead. The "
+        "estimate is δ samples old, so eq. (7) moves it δ steps ahead with the matrix "
+        "power A^δ"),
     "times_delta": (
         "A is multiplied by the number δ (A·δ). Eq. (7) needs the matrix power A^δ: A "
         "applied δ times in a row, one matrix product per sample"),

@@ -250,6 +250,9 @@ def _trial() -> dict[str, object]:
                 (delay_signal(estimates, 2 * steps) @ np.linalg.matrix_power(
                     DEFAULT.A, steps).T)[:, 0],
             "it holds the delayed estimate, not the compensated one": signals["delayed"],
+            "A is applied once, not δ times: it is A ẑ_(j−δ), one step ahead. The estimate is "
+                "δ samples old, so eq. (7) moves it δ steps ahead with the matrix power A^δ":
+                (delay_signal(estimates, steps) @ DEFAULT.A.T)[:, 0],
             velocities: ahead(estimates, column=1),
             **{cause: ahead(estimates, shift) for cause, shift in off_by_one.items()},
         },
@@ -290,7 +293,19 @@ def _judge_signal(name: str, value: object, right: np.ndarray, steps: int,
     raise CheckFailed(
         f"{name} does not match the signal recomputed from the task's inputs (to "
         f"{tolerance_text(FUNCTION_RTOL)} of its largest value), and not by one of the usual "
-        f"mistakes: was it made from your my_filter's estimates of the trial's readings y?")
+        f"mistakes: {_SIGNAL_HINTS[name]}")
+
+
+#: What :func:`_judge_signal` asks when no usual mistake explains a signal.
+_SIGNAL_HINTS = {
+    "late_readings": "is it the trial's readings y, shifted δ samples later (row j = "
+                     "y_(j−δ))?",
+    "delayed": "is it your my_filter's estimates of the trial's readings y, shifted δ "
+               "samples later (row j = ẑ_(j−δ))?",
+    "compensated": "check which estimate row j starts from (ẑ_(j−δ), from your my_filter's "
+                   "estimates of the trial's readings y) and which power of A moves it (A^δ, "
+                   "with δ = steps)",
+}
 
 
 def check_delay_signals(late_readings: np.ndarray, delayed: np.ndarray,
@@ -402,6 +417,10 @@ def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -
         "what the delay costs (delayed − undelayed)": metrics.mean_ci95(cost / won),
         "it is in per cent; give the share as a fraction (0.5 for half)":
             metrics.Interval(100 * right.mean, 100 * right.low, 100 * right.high, right.runs),
+        "one of its two differences is reversed (the share is negative): it is (delayed − "
+        "compensated) / (undelayed − delayed) or (compensated − delayed) / (delayed − "
+        "undelayed). Both differences are delayed minus the other, and both are positive: "
+        "(delayed − compensated) / (delayed − undelayed)": metrics.mean_ci95(won / (now - delayed)),
         "it divides by compensated − undelayed; the delay's cost is delayed − undelayed":
             metrics.mean_ci95(won / (predicted - now)),
         "it divides by the undelayed MSE; the delay's cost is what the delay adds to it, "
