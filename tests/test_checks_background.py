@@ -81,6 +81,10 @@ def predict_covariance(P, F, G, sigma, *, mistake=""):
         return F @ P @ F + sigma**2 * G @ G.T
     if mistake == "not moved":
         return P + sigma**2 * G @ G.T
+    if mistake == "no Ft":
+        return F @ P + sigma**2 * G @ G.T
+    if mistake == "no F":
+        return P @ F.T + sigma**2 * G @ G.T
     return F @ P @ F.T + sigma**2 * G @ G.T
 
 
@@ -95,6 +99,8 @@ def test_check_covariance_step_passes_the_worked_solution(capsys):
     ("sigma", "σ is used where its square belongs"),
     ("no transpose", "the second F is not transposed"),
     ("not moved", "P is not carried through the model"),
+    ("no Ft", "Fᵀ is missing on the right"),
+    ("no F", "F is missing on the left"),
 ])
 def test_check_covariance_step_names_each_typical_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_covariance_step,
@@ -217,6 +223,9 @@ def test_check_eyes_closed_checks_the_function_first():
     assert_fails("σ is used where its square belongs", checks.check_eyes_closed,
                  lambda P, F, G, s: predict_covariance(P, F, G, s, mistake="sigma"),
                  two_sigma, crossing)
+    assert_fails("Fᵀ is missing on the right", checks.check_eyes_closed,
+                 lambda P, F, G, s: predict_covariance(P, F, G, s, mistake="no Ft"),
+                 two_sigma)
 
 
 # --- check_jerk_stds (Task 3) ----------------------------------------------------------------

@@ -177,10 +177,21 @@ def _covariance_mistakes(P, F, G, sigma) -> dict[str, tuple[np.ndarray, str]]:
         "sigma": (F @ P @ F.T + sigma * G @ G.T, "σ is used where its square belongs: a "
                                                  "covariance adds variances, G σ² Gᵀ"),
         "no_transpose": (F @ P @ F + noise, "the second F is not transposed: F P Fᵀ"),
+        "no_second_F": (F @ P + noise, "Fᵀ is missing on the right: F P moves the covariance "
+                                       "only once; the state moves as F z, so its covariance "
+                                       "becomes F P Fᵀ (F on the left and Fᵀ on the right)"),
+        "no_first_F": (P @ F.T + noise, "F is missing on the left: P Fᵀ moves the covariance "
+                                        "only once; the state moves as F z, so its covariance "
+                                        "becomes F P Fᵀ (F on the left and Fᵀ on the right)"),
         "not_moved": (P + noise, "P is not carried through the model: the old covariance "
                                  "must be moved one step by F (F P Fᵀ) before the noise is "
                                  "added"),
     }
+
+
+#: The mistakes of :func:`_covariance_mistakes`, in the order they are tried.
+_COVARIANCE_MISTAKE_ORDER = ("sides", "no_noise", "sigma", "no_transpose", "no_second_F",
+                             "no_first_F", "not_moved")
 
 
 def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None:
@@ -201,7 +212,8 @@ def check_covariance_step(predict_covariance: Callable[..., np.ndarray]) -> None
     CheckFailed
         If the function is not written yet, raises, changes its inputs, returns the
         wrong shape, or another matrix; typical mistakes are named (F on the wrong
-        sides, no noise term, σ instead of σ², no transpose, P not moved by F).
+        sides, no noise term, σ instead of σ², no transpose, Fᵀ or F missing, P not moved
+        by F).
     """
     name = _judge_covariance_step(predict_covariance, "check_covariance_step")
     passed(f"{name} gives F P Fᵀ + G σ² Gᵀ (Lesson 0.5 eq. (9)) on "
@@ -230,7 +242,7 @@ def _judge_covariance_step(predict_covariance: Callable[..., np.ndarray], check:
             wrong.append((array, P, F, G, sigma, where))
     if not wrong:
         return name
-    for key in ("sides", "no_noise", "sigma", "no_transpose", "not_moved"):
+    for key in _COVARIANCE_MISTAKE_ORDER:
         if all(close(array, _covariance_mistakes(P, F, G, sigma)[key][0], MATRIX_RTOL)
                for array, P, F, G, sigma, _ in wrong):
             raise CheckFailed(f"{name} does not follow eq. (9): "
