@@ -112,9 +112,18 @@ def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
         fused, vision = vision, fused
     if mistake == "all states":
         fused = fused_all
-    start = 1 if mistake == "burn-in in seconds" else 0 if mistake == "whole trial" else burn
+    if mistake == "P0 large":
+        big = np.diag([1e5, 1e5, 1e5])
+        fused = reference.lqe_filter(y, A, C, Q, R, z0, big)[:, 0]
+        vision = reference.lqe_filter(y[:, :1], A, C[:1], Q, R[:1, :1], z0, big)[:, 0]
+    if mistake == "metres":
+        fused = reference.lqe_filter(y / 100, A, C, Q, R, z0, P0)[:, 0]
+    start = {"burn-in in seconds": 1, "whole trial": 0, "burn-in + 1": burn + 1,
+             "burn-in - 1": burn - 1}.get(mistake, burn)
     mse_fused = np.mean((fused[start:] - truth[start:]) ** 2) if fused.ndim == 1 else 0.0
     mse_vision = np.mean((vision[start:] - truth[start:]) ** 2)
+    if mistake == "against the readings":
+        mse_vision = np.mean((vision[burn:] - y[burn:, 0]) ** 2)
     if mistake == "rmse":
         mse_fused = np.sqrt(mse_fused)
     if mistake == "readings' MSE":
@@ -153,6 +162,14 @@ def test_check_fusion_trial_passes_the_worked_solution(capsys) -> None:
     ("readings' MSE", "it is the MSE of vision's raw readings, not of the filter's estimate"),
     ("fused MSE twice", "mse_vision_trial = 0.15961 cm² is not right: it is the MSE of the "
                         "fused filter's estimate"),
+    ("against the readings", "mse_vision_trial = 1.6"),
+    ("against the readings", "is not right: it compares the estimate with vision's readings "
+                             "(column 0 of y), not with the true position"),
+    ("burn-in + 1", "is not right: it leaves out one sample too many (101 instead of 100)"),
+    ("burn-in - 1", "is not right: it leaves out one sample too few (99 instead of 100)"),
+    ("P0 large", "vision_positions is not right: P0 is diag(1e5), notebook 02's uncertain "
+                 "start: this question starts from P0 = diag(1)"),
+    ("metres", "fused_positions is not right: the readings are in metres"),
 ])
 @pytest.mark.slow
 def test_check_fusion_trial_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
@@ -187,10 +204,17 @@ def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object]:
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
     vision_mc = experiments.track(DEFAULT, ("vision",), runs=runs)
     fused_mc = experiments.track(DEFAULT, FUSED, runs=runs)
-    start = {"burn-in in seconds": 1, "whole trial": 0}.get(mistake, burn)
+    start = {"burn-in in seconds": 1, "whole trial": 0, "burn-in + 1": burn + 1,
+             "burn-in - 1": burn - 1}.get(mistake, burn)
     mse_vision = metrics.mse(vision_mc.positions, truth, start)
     mse_fused = metrics.mse(fused_mc.positions, truth, start)
     difference = metrics.mean_ci95(mse_vision - mse_fused)
+    if mistake in ("burn-in + 1", "burn-in - 1"):   # per-run MSEs right, difference not
+        mse_vision = metrics.mse(vision_mc.positions, truth, burn)
+        mse_fused = metrics.mse(fused_mc.positions, truth, burn)
+    if mistake == "against the readings":
+        mse_vision = np.mean((vision_mc.positions - vision_mc.measurements[..., 0])[:, burn:] ** 2,
+                             axis=-1)
     if mistake == "whole-trial difference":
         difference = metrics.mean_ci95(metrics.mse(vision_mc.positions, truth)
                                        - metrics.mse(fused_mc.positions, truth))
@@ -233,6 +257,12 @@ def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
     ("whole trial", "mse_vision is not right: it is the MSE of the whole trial"),
     ("burn-in in seconds", "mse_vision is not right: it leaves out the first 1 sample(s)"),
     ("swapped", "mse_vision is not right: these are the fused filter's MSEs"),
+    ("against the readings", "mse_vision is not right: it compares the estimate with vision's "
+                             "readings (column 0 of y), not with the true position"),
+    ("burn-in + 1", "difference is not right: it leaves out one sample too many (101 instead "
+                    "of 100)"),
+    ("burn-in - 1", "difference is not right: it leaves out one sample too few (99 instead "
+                    "of 100)"),
 ])
 @pytest.mark.slow
 def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:

@@ -90,9 +90,19 @@ def test_mse_mistakes_are_the_usual_slips() -> None:
     assert values["the errors are not squared (the mean error)"] == 0.0
     assert values["it is the MSE of the whole trial"] == np.mean(estimate**2)
     assert values["it leaves out the first 1 sample(s)"] == np.mean(estimate[1:] ** 2)
+    assert values["it leaves out one sample too many (3 instead of 2)"] == np.mean(
+        estimate[3:] ** 2)
+    assert values["it leaves out one sample too few (1 instead of 2)"] == np.mean(
+        estimate[1:] ** 2)
+    readings = mse_mistakes(estimate, truth, 2, readings={"the readings": estimate - 1.0})
+    assert readings["it compares the estimate with the readings, not with the true position: "
+                    "the MSE measures how far the estimate is from the truth"] == 1.0
     with_nan = mse_mistakes(np.array([np.nan, 1.0, 2.0]), np.zeros(3), 1)
     assert with_nan["it is the MSE of the whole trial: the first 1 samples (the burn-in) must "
                     "be left out"] is None
+    assert with_nan["it leaves out one sample too few (0 instead of 1): the burn-in is the "
+                    "first 1 samples, so keep the samples from index 1 on"] is None
+    assert not [cause for cause in mse_mistakes(estimate, truth, 0) if "one sample" in cause]
 
 
 # ------------------------------------------------------------------------------------------

@@ -19,7 +19,15 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .initial_covariance import P0_NAMES, QUESTION_P0
+from .judging import (
+    CM_PER_M,
+    burn_in_slips,
+    interval_mistakes,
+    judge,
+    judge_interval,
+    mse_mistakes,
+)
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -183,16 +191,44 @@ VISION_WITH_BOTH_SENSES = ("the vision-only run kept both senses' C and R: with 
                            "readings y[:, :1] it needs C[:1] (1, 3) and R[:1, :1] (1, 1) too")
 
 
-def engine_positions(readings: np.ndarray, sigmas: list[float], column: int = 0) -> np.ndarray:
+def engine_positions(readings: np.ndarray, sigmas: list[float], column: int = 0,
+                     p0_variance: float | None = None) -> np.ndarray:
     """Column ``column`` of the engine's estimates on ``readings`` (n, m), R = diag(σ²).
 
     The model is the tasks' (:func:`lqe_helpers.experiments.filter_model` of the first m
-    senses): DEFAULT's A, Q, z0 and P0, C with one position row per sense. Shared with
-    :mod:`~lqe_helpers.checks.fusion_further`.
+    senses): DEFAULT's A, Q, z0 and P0 (or ``p0_variance`` · I), C with one position row
+    per sense. Shared with :mod:`~lqe_helpers.checks.fusion_further`.
     """
     senses = FUSED[:readings.shape[-1]]
-    return experiments.filter_model(DEFAULT, senses, sigmas=sigmas).filter(
+    return experiments.filter_model(DEFAULT, senses, sigmas=sigmas,
+                                    p0_variance=p0_variance).filter(
         readings).estimates[..., column]
+
+
+def sensor_readings(y: np.ndarray) -> dict[str, np.ndarray]:
+    """Each sense's readings (..., n) (cm) of ``y`` (..., n, m), by how a message names them.
+
+    For :func:`~lqe_helpers.checks.judging.mse_mistakes`: an MSE taken against the readings
+    instead of the truth. Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
+    """
+    return {f"{sense}'s readings (column {column} of y)": y[..., column]
+            for column, sense in enumerate(FUSED[:y.shape[-1]])}
+
+
+def _setup_slips(y: np.ndarray, sigmas: list[float]) -> dict[str, np.ndarray]:
+    """Positions (n,) (cm) of the filter on ``y`` (n, m) with a slip in the set-up's inputs.
+
+    P0 of the tutorial's uncertain start (notebook 02's diag(1e5)) where the question's
+    diag(1) belongs, and the readings in metres (divided by :data:`judging.CM_PER_M`).
+    """
+    return {
+        f"P0 is {P0_NAMES[1]}, notebook 02's uncertain start: this question starts from "
+        f"P0 = {P0_NAMES[0]}, the set-up cell's P0":
+            engine_positions(y, sigmas, p0_variance=QUESTION_P0[1]),
+        "the readings are in metres (y divided by 100) while R, Q and the truth are in cm: "
+        "give my_filter the readings y as they are, in cm":
+            engine_positions(y / CM_PER_M, sigmas),
+    }
 
 
 @functools.cache
@@ -220,6 +256,7 @@ def _trial() -> dict[str, object]:
             "these are vision's readings, not the filter's estimate": y[:, 0],
             VISION_WITH_BOTH_SENSES: engine_positions(np.repeat(y[:, :1], 2, axis=1),
                                                       [sigma_v, sigma_p]),
+            **_setup_slips(y[:, :1], [sigma_v]),
         },
         "fused": {
             "it is the vision-only filter's estimate: fused_positions comes from the filter "
@@ -231,6 +268,7 @@ def _trial() -> dict[str, object]:
             velocity: engine_positions(y, [sigma_v, sigma_p], 1),
             sigma_for_variance: engine_positions(y, root["fused"]),
             "these are vision's readings, not the filter's estimate": y[:, 0],
+            **_setup_slips(y, [sigma_v, sigma_p]),
         },
     }
 
@@ -246,7 +284,7 @@ def _trial() -> dict[str, object]:
                 mse(y[:, 0]),
             **{f"it comes from a wrong estimate: {cause}": mse(wrong)
                for cause, wrong in mistakes[kind].items() if wrong is not positions[other]},
-            **mse_mistakes(positions[kind], truth, burn, dt),
+            **mse_mistakes(positions[kind], truth, burn, dt, readings=sensor_readings(y)),
         }
     return {"positions": positions, "mistakes": mistakes,
             "mse": {kind: mse(value) for kind, value in positions.items()},
@@ -326,14 +364,16 @@ def monte_carlo_mses() -> dict[str, np.ndarray]:
     """Task 3's runs: positions (runs, n) (cm) and per-run MSEs (runs,) (cm²), read-only.
 
     Keys ``vision`` and ``fused`` (positions), ``<filter>_after`` (after the burn-in),
-    ``<filter>_whole``, ``raw`` (vision's readings). Shared with
+    ``<filter>_whole``, ``raw`` (vision's readings' MSE), ``<filter>_readings`` (its runs'
+    readings, (runs, n, m), cm). Shared with
     :mod:`~lqe_helpers.checks.fusion_further`.
     """
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
     vision = vision_runs()
     fused = experiments.track(DEFAULT, FUSED, runs=runs)
     values = {"vision": vision.positions, "fused": fused.positions,
-              "raw": vision.measurement_mse("vision")}
+              "raw": vision.measurement_mse("vision"),
+              "vision_readings": vision.measurements, "fused_readings": fused.measurements}
     for kind in ("vision", "fused"):
         values[f"{kind}_after"] = metrics.mse(values[kind], truth, burn)
         values[f"{kind}_whole"] = metrics.mse(values[kind], truth)
@@ -393,7 +433,8 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
                   f"MSEs": values[f"{other}_after"],
                   "these are the MSEs of vision's raw readings, not of the filter's "
                   "estimates": values["raw"],
-                  **mse_mistakes(values[kind], truth, burn, DEFAULT.dt)})
+                  **mse_mistakes(values[kind], truth, burn, DEFAULT.dt,
+                                 readings=sensor_readings(values[f"{kind}_readings"]))})
 
     judge_together(functools.partial(per_run, "vision", "fused", "mse_vision", mse_vision),
                    functools.partial(per_run, "fused", "vision", "mse_fused", mse_fused))
@@ -408,6 +449,9 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
         "it is the relative difference in % of the vision-only MSE; the task asks for the "
         "difference itself (cm²)": metrics.mean_ci95(100 * (vision - fused) / vision),
     }
+    for cause, start in burn_in_slips(burn, truth.size).items():
+        mistakes[cause] = metrics.mean_ci95(metrics.mse(values["vision"], truth, start)
+                                            - metrics.mse(values["fused"], truth, start))
     if "vision_seconds" in values:
         mistakes[f"it leaves out the first {burn * DEFAULT.dt:g} sample(s): the burn-in is "
                  f"{burn * DEFAULT.dt:g} s, which is {burn} samples"] = (

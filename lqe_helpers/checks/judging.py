@@ -12,7 +12,8 @@ interval), with a catalogue of likely mistakes, each computed from the same inpu
 
 The first mistake that matches the student's value (and not the right one) names the
 cause in the message, in words, without code. :func:`mse_mistakes` and
-:func:`interval_mistakes` give the mistakes every MSE and every paired difference can have.
+:func:`interval_mistakes` give the mistakes every MSE and every paired difference can have;
+:func:`burn_in_slips` the burn-in off by one sample, for a check that makes its own MSEs.
 """
 
 from __future__ import annotations
@@ -25,6 +26,9 @@ from .. import metrics
 from .machinery import CheckFailed, argument_array, tolerance_text
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
+
+#: Centimetres in a metre: readings a student converts to metres are the cm ones divided by it.
+CM_PER_M = 100.0
 
 #: The normal distribution's two-sided 95 % point, the usual wrong stand-in for Student's t.
 NORMAL_95 = 1.959963984540054
@@ -259,8 +263,30 @@ def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
     }
 
 
+def burn_in_slips(burn_in_steps: int, n: int) -> dict[str, int]:
+    """The burn-in off by one sample: cause → the first sample such an MSE keeps.
+
+    Parameters
+    ----------
+    burn_in_steps : int
+        Samples the task leaves out at the start (0: no burn-in, no slips).
+    n : int
+        Samples in the trial.
+    """
+    slips = {}
+    for shift, which in ((1, "one sample too many"), (-1, "one sample too few")):
+        start = burn_in_steps + shift
+        if burn_in_steps and 0 <= start < n:
+            slips[f"it leaves out {which} ({start} instead of {burn_in_steps}): the burn-in "
+                  f"is the first {burn_in_steps} samples, so keep the samples from index "
+                  f"{burn_in_steps} on"] = start
+    return slips
+
+
 def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
-                 dt: float | None = None) -> dict[str, np.ndarray | None]:
+                 dt: float | None = None,
+                 readings: Mapping[str, np.ndarray] | None = None,
+                 ) -> dict[str, np.ndarray | None]:
     """The usual mistakes of a mean squared error after a burn-in.
 
     Parameters
@@ -273,14 +299,18 @@ def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
         Samples to leave out at the start.
     dt : float, optional
         Time step (s): adds the burn-in counted in seconds instead of samples.
+    readings : mapping of str to ndarray, shape (..., n), optional
+        Readings (cm) a student may compare with instead of ``truth``, by what they are
+        ("vision's readings"): adds the MSE against each.
 
     Returns
     -------
     dict of str to ndarray or None
         Cause → the MSE (shape (...)) that mistake gives: the root of the MSE, the sum
         instead of the mean, errors not squared, absolute errors, the variance of the
-        error, the whole trial, the burn-in in seconds. None where the mistake gives
-        no finite number (NaN samples it would include).
+        error, the whole trial, the burn-in one sample too long or too short, the burn-in
+        in seconds, the readings for the truth. None where the mistake gives no finite
+        number (NaN samples it would include).
     """
     with np.errstate(all="ignore"):
         error = estimate - truth
@@ -301,6 +331,12 @@ def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
         if burn_in_steps:
             mistakes[f"it is the MSE of the whole trial: the first {burn_in_steps} samples "
                      f"(the burn-in) must be left out"] = np.mean(error**2, axis=-1)
+        for cause, start in burn_in_slips(burn_in_steps, error.shape[-1]).items():
+            mistakes[cause] = np.mean(error[..., start:] ** 2, axis=-1)
+        for what, values in (readings or {}).items():
+            mistakes[f"it compares the estimate with {what}, not with the true position: "
+                     f"the MSE measures how far the estimate is from the truth"] = np.mean(
+                (estimate - values)[..., burn_in_steps:] ** 2, axis=-1)
         if dt is not None and burn_in_steps:
             seconds = burn_in_steps * dt
             if float(seconds).is_integer() and int(seconds) != burn_in_steps:
