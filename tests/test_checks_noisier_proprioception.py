@@ -107,6 +107,10 @@ def task2(slip: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     column = 1 if slip in ("velocity", "velocity in the fused") else 0
     if slip == "sigmas in R":
         R = np.diag([SIGMA_V, SIGMA_P])
+    if slip == "P0 large":
+        P0 = np.diag([1e5, 1e5, 1e5])
+    if slip == "metres":
+        y = y / 100
     fused_positions = my_filter(y, A, C, Q, R, z0, P0)[:, column]
     seen = y[:, 1:] if slip == "proprioception column" else y[:, :1]
     r_vision = R[1:, 1:] if slip == "R of proprioception" else R[:1, :1]
@@ -118,9 +122,12 @@ def task2(slip: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
         vision_positions = y[:, 0]
     if slip == "swapped":
         vision_positions, fused_positions = fused_positions, vision_positions
-    burn = {"whole trial": 0, "burn-in in seconds": int(DEFAULT.burn_in)}.get(slip, BURN)
+    burn = {"whole trial": 0, "burn-in in seconds": int(DEFAULT.burn_in),
+            "burn-in + 1": BURN + 1, "burn-in - 1": BURN - 1}.get(slip, BURN)
     mse_fused_trial = metrics.mse(fused_positions, TRUTH, burn)
     mse_vision_trial = metrics.mse(vision_positions, TRUTH, burn)
+    if slip == "against the readings":
+        mse_fused_trial = metrics.mse(fused_positions - y[:, 0], np.zeros_like(TRUTH), burn)
     if slip == "rmse":
         mse_fused_trial = np.sqrt(mse_fused_trial)
     if slip == "MSEs swapped":
@@ -151,6 +158,17 @@ def test_check_noisier_trial_passes_the_worked_answer(capsys) -> None:
     ("burn-in in seconds", "the burn-in is 1 s, which is 100 samples"),
     ("rmse", "mse_fused_trial = 0.5233"),
     ("rmse", "it is the root mean squared error (RMSE, in cm)"),
+    ("P0 large", "vision_positions is not right: P0 is diag(1e5), notebook 02's uncertain "
+                 "start"),
+    ("P0 large", "Also, fused_positions is not right: P0 is diag(1e5)"),
+    ("metres", "fused_positions is not right: the readings are in metres"),
+    ("metres", "vision_positions is not right: the readings are in metres"),
+    ("burn-in + 1", "mse_vision_trial = 0.304361 cm² is not right"),
+    ("burn-in + 1", "it leaves out one sample too many (101 instead of 100)"),
+    ("burn-in - 1", "it leaves out one sample too few (99 instead of 100)"),
+    ("against the readings", "mse_fused_trial = 1.69375 cm² is not right: it compares the "
+                             "estimate with vision's readings (column 0 of y), not with the "
+                             "true position"),
 ])
 @pytest.mark.slow
 def test_check_noisier_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:

@@ -215,11 +215,12 @@ def sensor_readings(y: np.ndarray) -> dict[str, np.ndarray]:
             for column, sense in enumerate(FUSED[:y.shape[-1]])}
 
 
-def _setup_slips(y: np.ndarray, sigmas: list[float]) -> dict[str, np.ndarray]:
+def setup_slips(y: np.ndarray, sigmas: list[float]) -> dict[str, np.ndarray]:
     """Positions (n,) (cm) of the filter on ``y`` (n, m) with a slip in the set-up's inputs.
 
     P0 of the tutorial's uncertain start (notebook 02's diag(1e5)) where the question's
     diag(1) belongs, and the readings in metres (divided by :data:`judging.CM_PER_M`).
+    Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
     """
     return {
         f"P0 is {P0_NAMES[1]}, notebook 02's uncertain start: this question starts from "
@@ -256,7 +257,7 @@ def _trial() -> dict[str, object]:
             "these are vision's readings, not the filter's estimate": y[:, 0],
             VISION_WITH_BOTH_SENSES: engine_positions(np.repeat(y[:, :1], 2, axis=1),
                                                       [sigma_v, sigma_p]),
-            **_setup_slips(y[:, :1], [sigma_v]),
+            **setup_slips(y[:, :1], [sigma_v]),
         },
         "fused": {
             "it is the vision-only filter's estimate: fused_positions comes from the filter "
@@ -268,7 +269,7 @@ def _trial() -> dict[str, object]:
             velocity: engine_positions(y, [sigma_v, sigma_p], 1),
             sigma_for_variance: engine_positions(y, root["fused"]),
             "these are vision's readings, not the filter's estimate": y[:, 0],
-            **_setup_slips(y, [sigma_v, sigma_p]),
+            **setup_slips(y, [sigma_v, sigma_p]),
         },
     }
 

@@ -30,6 +30,8 @@ from .fusion import (
     judge_noise_matrix,
     judge_together,
     position_array,
+    sensor_readings,
+    setup_slips,
 )
 from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
 from .machinery import (
@@ -174,6 +176,7 @@ def _trial() -> dict[str, dict]:
             raw: y[:, 0],
             VISION_WITH_BOTH_SENSES: engine_positions(np.repeat(y[:, :1], 2, axis=1),
                                                       [SIGMA_V, SIGMA_P]),
+            **setup_slips(y[:, :1], [SIGMA_V]),
         },
         "fused": {
             "it is the vision-only filter's estimate: the fused filter reads both columns "
@@ -183,6 +186,7 @@ def _trial() -> dict[str, dict]:
             f"it is the filter of question (c), σ_p = {SIGMA_P_C:g} cm; (d) sets σ_p = "
             f"{SIGMA_P:g} cm": engine_positions(y, [SIGMA_V, SIGMA_P_C]),
             raw: y[:, 0],
+            **setup_slips(y, [SIGMA_V, SIGMA_P]),
         },
     }
 
@@ -199,7 +203,8 @@ def _trial() -> dict[str, dict]:
                 mse(y[:, 1]),
             **{f"it comes from a wrong estimate: {cause}": mse(wrong)
                for cause, wrong in mistakes[kind].items() if wrong is not positions[other]},
-            **mse_mistakes(positions[kind], TRUTH, BURN, DEFAULT.dt),
+            **mse_mistakes(positions[kind], TRUTH, BURN, DEFAULT.dt,
+                           readings=sensor_readings(y)),
         }
     return {"positions": positions, "mistakes": mistakes,
             "mse": {kind: mse(value) for kind, value in positions.items()},
