@@ -21,12 +21,12 @@ TRUTH = DEFAULT.truth
 P0_SMALL, P0_LARGE = np.diag([1.0, 1.0, 1.0]), np.diag([1e5, 1e5, 1e5])
 
 
-def hand_convergence_time(curve: np.ndarray, dt: float) -> float:
+def hand_convergence_time(curve: np.ndarray, dt: float, factor: float = 2.0) -> float:
     """The pack's definition, as a plain loop: after the last sample above 2 × the level."""
     steady = sum(curve[len(curve) // 2:]) / (len(curve) - len(curve) // 2)
     last_outside = -1
     for index, value in enumerate(curve):
-        if value > 2 * steady:
+        if value > factor * steady:
             last_outside = index
     return (last_outside + 1) * dt
 
@@ -132,6 +132,10 @@ def test_check_start_of_trial_names_each_typical_mistake(trial) -> None:
          (small, run(trial, np.sqrt(1e5) * np.eye(3)))),
         ("estimates_small has 1001 rows for 1000 readings",
          (np.vstack([trial["z0"], small]), large)),
+        ("estimates_small is not right: the readings are in metres",
+         (run(trial, P0_SMALL, y=trial["y"] / 100), run(trial, P0_LARGE, y=trial["y"] / 100))),
+        ("estimates_large is not right: the readings are in metres",
+         (small, run(trial, P0_LARGE, y=trial["y"] / 100))),
         # A filter broken since notebook 01 (Q left out of P): no usual mistake, a hint.
         ("if you changed my_filter since notebook 01, run its check there again",
          (run(trial, P0_SMALL, Q=np.zeros((3, 3))), large)),
@@ -166,6 +170,25 @@ def test_check_convergence_times_passes_the_worked_solution(capsys, times) -> No
     assert times[1] < 0.2 < 0.4 < times[0] < 1.0    # the question's contrast
     line = assert_passes(capsys, checks.check_convergence_times, *times)
     assert "over 300 runs" in line and "to 1e-9 s" in line
+
+
+def test_check_convergence_times_names_the_slips_made_for_both(squared) -> None:
+    """One slip in the code makes both times; named for both, not as another slip that
+    happens to give one of them (issue 23: a band of 3 × was called the mean absolute error)."""
+    curves = squared.mean(axis=0)
+    band3 = [hand_convergence_time(curve, DT, 3.0) for curve in curves]
+    message = assert_fails("are not right: the band is 3 × the steady level; the definition's "
+                           "band is 2 ×", checks.check_convergence_times, *band3)
+    assert "mean absolute error" not in message and message.startswith("t_small = ")
+    median = [hand_convergence_time(np.median(squared[:, i], axis=0), DT) for i in range(2)]
+    message = assert_fails("are not right: the curve is the median of the squared errors over "
+                           "the runs", checks.check_convergence_times, *median)
+    assert "one of these" not in message
+    # For one P0 alone, a time two slips give names both, not only the first.
+    message = assert_fails("t_small = 0.54 s is not right: two or more slips give this same "
+                           "time", checks.check_convergence_times, band3[0],
+                           hand_convergence_time(curves[1], DT))
+    assert "mean absolute error" in message and "the band is 3 ×" in message
 
 
 def test_check_convergence_times_names_each_typical_mistake(batch, squared, times) -> None:
@@ -230,6 +253,12 @@ def test_check_start_and_after_names_each_typical_mistake(batch) -> None:
          "runs", (paired(first_runs), after)),
         ("after_difference is not right: it leaves out only the first sample",
          (start, paired(metrics.mse(positions, truth, 1)))),
+        ("after_difference is not right: it leaves out one sample too many (101 instead of "
+         "100)", (start, paired(metrics.mse(positions, truth, BURN + 1)))),
+        ("after_difference is not right: it leaves out one sample too few (99 instead of 100)",
+         (start, paired(metrics.mse(positions, truth, BURN - 1)))),
+        ("start_difference is not right: the first second ends one sample early",
+         (paired(metrics.mse(positions[..., :BURN - 1], truth[:BURN - 1])), after)),
         ("the sign is reversed", (metrics.mean_ci95(one_mse[:, 1] - one_mse[:, 0]), after)),
         ("it combines the two separate intervals",
          (metrics.Interval(alone[0].mean - alone[1].mean, alone[0].low - alone[1].high,

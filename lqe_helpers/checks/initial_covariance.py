@@ -23,7 +23,15 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import (
+    CM_PER_M,
+    burn_in_slips,
+    interval_mistakes,
+    judge,
+    judge_interval,
+    judge_seconds,
+    judge_seconds_together,
+)
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -162,10 +170,10 @@ def _judge_covariances(P0_small: object, P0_large: object) -> None:
 # ------------------------------------------------------------------------------------------
 
 def _trial_estimates(p0_variance: float, *, z0: np.ndarray | None = None,
-                     r_variance: float | None = None) -> np.ndarray:
+                     r_variance: float | None = None, y_divisor: float = 1.0) -> np.ndarray:
     """The engine's estimates (n, 3) of the task's trial, with one input changed or none."""
     vision = experiments.filter_model(DEFAULT, p0_variance=p0_variance)
-    y = experiments.track(DEFAULT).measurements
+    y = experiments.track(DEFAULT).measurements / y_divisor
     R = vision.R if r_variance is None else np.array([[r_variance]])
     start = vision.z0 if z0 is None else z0
     return experiments.FilterModel(vision.A, vision.C, vision.Q, R, start,
@@ -185,6 +193,8 @@ def _trial() -> dict[str, np.ndarray]:
         **{f"r_sigma_{name}": _trial_estimates(p0, r_variance=sigma_v)
            for name, p0 in zip(_SMALL_LARGE, QUESTION_P0, strict=True)},
         **{f"std_{name}": _trial_estimates(np.sqrt(p0))
+           for name, p0 in zip(_SMALL_LARGE, QUESTION_P0, strict=True)},
+        **{f"metres_{name}": _trial_estimates(p0, y_divisor=CM_PER_M)
            for name, p0 in zip(_SMALL_LARGE, QUESTION_P0, strict=True)},
     }
 
@@ -247,6 +257,8 @@ def check_start_of_trial(P0_small: np.ndarray, P0_large: np.ndarray,
                       runs[f"r_sigma_{this}"],
                   "P0 held standard deviations (√p0) on its diagonal, not variances":
                       runs[f"std_{this}"],
+                  "the readings are in metres (y divided by 100) while R, Q and P0 are in cm: "
+                  "give my_filter the readings y as they are, in cm": runs[f"metres_{this}"],
               })
     passed(f"P0_small = {QUESTION_P0[0]:g} · I and P0_large = {QUESTION_P0[1]:g} · I (3 × 3, "
            f"variances on the diagonal, to {tolerance_text(MATRIX_RTOL)} relative); "
@@ -287,38 +299,10 @@ def crossing_times(curve: np.ndarray, dt: float) -> dict[str, float]:
     return times
 
 
-def judge_seconds(name: str, value: object, expected: float | np.ndarray,
-                  mistakes: dict[str, float | np.ndarray | None], what: str) -> np.ndarray:
-    """CheckFailed unless ``value`` equals ``expected`` (s) within :data:`TIME_ATOL`.
-
-    ``expected`` is one time or an array of times; ``mistakes`` maps a cause, in words,
-    to the value(s) that mistake gives (None: cannot occur). Returns the student's value.
-    """
-    expected = np.asarray(expected, dtype=float)
-    due = ("one number of seconds" if expected.ndim == 0
-           else f"an array of shape {expected.shape} (s)")
-    got = argument_array(value, name, due, allow_nan=True)
-    if expected.ndim == 0 and got.size == 1:
-        got = got.reshape(())
-    if got.shape != expected.shape:
-        raise CheckFailed(f"{name} must be {due}, got an array of shape {got.shape}")
-    if not np.all(np.isfinite(got)):
-        raise CheckFailed(f"{name} must hold finite numbers of seconds, got NaN or inf")
-
-    def near(a: np.ndarray, b: np.ndarray) -> bool:
-        return bool(np.all(np.abs(a - b) <= TIME_ATOL))
-
-    if near(got, expected):
-        return got
-    shown = f" = {float(got):g} s" if got.ndim == 0 else ""
-    for cause, wrong in mistakes.items():
-        if wrong is None:
-            continue
-        wrong = np.asarray(wrong, dtype=float)
-        if wrong.shape == expected.shape and not near(wrong, expected) and near(got, wrong):
-            raise CheckFailed(f"{name}{shown} is not right: {cause}")
-    raise CheckFailed(f"{name}{shown} does not match {what} (to {tolerance_text(TIME_ATOL)} "
-                      f"s), and not by one of the usual mistakes")
+#: The band of the definition of a convergence time: ``factor`` × the steady level
+#: (:func:`metrics.convergence_time`'s default), and other bands a student may take.
+BAND_FACTOR = 2.0
+_OTHER_FACTORS = (1.5, 3.0, 4.0, 5.0, 10.0)
 
 
 @functools.cache
@@ -328,6 +312,7 @@ def _convergence() -> dict[str, object]:
     runs = question_runs()
     error = runs.positions - DEFAULT.truth[:, 0]
     curves = squared.mean(axis=0)
+    medians = np.median(squared, axis=0)
     right = metrics.convergence_time(curves, dt)
     per_run = metrics.convergence_time(np.moveaxis(squared, 1, 0), dt)     # (2, runs)
     mistakes = []
@@ -355,6 +340,13 @@ def _convergence() -> dict[str, object]:
             "the curve is the filter's own variance of its position, not its actual "
             "squared error": float(metrics.convergence_time(runs.position_variances[0, index],
                                                             dt)),
+            "the curve is the median of the squared errors over the runs; the definition "
+            "uses their mean (the Monte Carlo mean)":
+                float(metrics.convergence_time(medians[index], dt)),
+            **{f"the band is {factor:g} × the steady level; the definition's band is "
+               f"{BAND_FACTOR:g} × (metrics.convergence_time's factor, left at its default)":
+                   float(metrics.convergence_time(curves[index], dt, factor))
+               for factor in _OTHER_FACTORS},
         })
     return {"right": right, "mistakes": mistakes, "runs": squared.shape[0]}
 
@@ -383,13 +375,17 @@ def check_convergence_times(t_small: float, t_large: float) -> None:
         another steady level, one time per run, ...
     """
     right = _convergence()
-    for index, (name, value) in enumerate((("t_small", t_small), ("t_large", t_large))):
+    given = {}
+    for name, value in (("t_small", t_small), ("t_large", t_large)):
         got = argument_array(value, name, "one number of seconds", allow_nan=True)
         if got.shape == (right["runs"],):
             raise CheckFailed(
                 f"{name} holds one convergence time per run ({got.size} values). The "
                 f"definition applies to the Monte Carlo mean: average the squared errors "
                 f"over the runs first, then take one convergence time of that mean curve")
+        given[name] = got
+    judge_seconds_together(given, right["right"], right["mistakes"])
+    for index, (name, got) in enumerate(given.items()):
         judge_seconds(name, got, float(right["right"][index]), right["mistakes"][index],
                        f"the convergence time of the Monte Carlo mean squared error from "
                        f"P0 = {P0_NAMES[index]}")
@@ -452,7 +448,7 @@ def check_start_and_after(start_difference: metrics.Interval,
         trial, the first second cut from the runs' axis or counted in seconds, the sign
         reversed, an unpaired interval, the RMSE, ...
     """
-    mses, burn = window_mses(), DEFAULT.burn_in_steps
+    mses, burn, squared = window_mses(), DEFAULT.burn_in_steps, squared_errors()
     runs = mses["start"].shape[0]
     names = ("diag(1)'s MSE", "diag(1e5)'s MSE")
     cases = (
@@ -463,12 +459,16 @@ def check_start_and_after(start_difference: metrics.Interval,
             "0 … burn_in − 1": _paired(mses["start_late"]),
             f"it covers only the first sample: the first second is {burn} samples of "
             f"{DEFAULT.dt:g} s": _paired(mses["one"]),
+            "the first second ends one sample early: the samples before burn_in are "
+            "0 … burn_in − 1": _paired(squared[..., :burn - 1].mean(axis=-1)),
         }),
         ("after_difference", after_difference, "after", "start", {
             "it is over the whole trial: leave out the first second (the samples before "
             "burn_in)": _paired(mses["whole"]),
             f"it leaves out only the first sample: the first second is {burn} samples of "
             f"{DEFAULT.dt:g} s": _paired(mses["after_one"]),
+            **{cause: _paired(squared[..., start:].mean(axis=-1))
+               for cause, start in burn_in_slips(burn, squared.shape[-1]).items()},
         }),
     )
     for name, interval, window, other, slips in cases:

@@ -18,12 +18,12 @@ cause in the message, in words, without code. :func:`mse_mistakes` and
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
 from .. import metrics
-from .machinery import CheckFailed, argument_array, tolerance_text
+from .machinery import TIME_ATOL, CheckFailed, argument_array, tolerance_text
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -114,6 +114,95 @@ def judge(name: str, value: object, expected: object, rtol: float, *,
     raise CheckFailed(
         f"{name}{_shown(got, unit)} does not match {what} (to {tolerance_text(rtol)} "
         f"relative), and not by one of the usual mistakes{f': {hint}' if hint else ''}")
+
+
+def _matching_causes(got: np.ndarray, expected: np.ndarray,
+                     mistakes: dict[str, float | np.ndarray | None],
+                     near: Callable[[np.ndarray, np.ndarray], bool]) -> list[str]:
+    """Every cause whose value explains ``got`` (and not ``expected``), in order.
+
+    Times are whole samples, so two slips can give the same time: each is then named.
+    """
+    causes = []
+    for cause, wrong in mistakes.items():
+        if wrong is None:
+            continue
+        wrong = np.asarray(wrong, dtype=float)
+        if wrong.shape == expected.shape and not near(wrong, expected) and near(got, wrong):
+            causes.append(cause)
+    return causes
+
+
+def _either(causes: list[str]) -> str:
+    """One cause as it is; several that give the same time, each named ("either … or …")."""
+    if len(causes) == 1:
+        return causes[0]
+    return ("two or more slips give this same time; it is one of these: "
+            + "; or ".join(causes))
+
+
+def judge_seconds(name: str, value: object, expected: float | np.ndarray,
+                  mistakes: dict[str, float | np.ndarray | None], what: str) -> np.ndarray:
+    """CheckFailed unless ``value`` equals ``expected`` (s) within :data:`TIME_ATOL`.
+
+    ``expected`` is one time or an array of times; ``mistakes`` maps a cause, in words,
+    to the value(s) that mistake gives (None: cannot occur). Returns the student's value.
+    """
+    expected = np.asarray(expected, dtype=float)
+    due = ("one number of seconds" if expected.ndim == 0
+           else f"an array of shape {expected.shape} (s)")
+    got = argument_array(value, name, due, allow_nan=True)
+    if expected.ndim == 0 and got.size == 1:
+        got = got.reshape(())
+    if got.shape != expected.shape:
+        raise CheckFailed(f"{name} must be {due}, got an array of shape {got.shape}")
+    if not np.all(np.isfinite(got)):
+        raise CheckFailed(f"{name} must hold finite numbers of seconds, got NaN or inf")
+
+    def near(a: np.ndarray, b: np.ndarray) -> bool:
+        return bool(np.all(np.abs(a - b) <= TIME_ATOL))
+
+    if near(got, expected):
+        return got
+    shown = f" = {float(got):g} s" if got.ndim == 0 else ""
+    causes = _matching_causes(got, expected, mistakes, near)
+    if causes:
+        raise CheckFailed(f"{name}{shown} is not right: {_either(causes)}")
+    raise CheckFailed(f"{name}{shown} does not match {what} (to {tolerance_text(TIME_ATOL)} "
+                      f"s), and not by one of the usual mistakes")
+
+
+def judge_seconds_together(given: Mapping[str, object], expected: object,
+                           mistakes: Sequence[Mapping[str, float | None]]) -> None:
+    """Times all wrong by one slip (one piece of code made them all): name it for all.
+
+    A cause is named if it explains every time, even where another slip explains one of
+    them too (for one P0 a band of 3 × the level and the mean absolute error give the same
+    time); every cause that explains them all is named. Otherwise nothing is raised, and
+    each time is judged alone (:func:`judge_seconds`).
+
+    Parameters
+    ----------
+    given : mapping of str to object
+        The student's times (s) by name, in the order of ``expected``.
+    expected : array_like, shape (len(given),)
+        The right times (s).
+    mistakes : sequence of mappings of str to float or None
+        For each time, cause → the time that slip gives; a cause is tried when every
+        mapping has it.
+    """
+    got = [float(value) for value in given.values() if np.size(value) == 1]
+    right = [float(value) for value in np.ravel(expected)]
+    if len(got) != len(right) or any(abs(g - r) <= TIME_ATOL
+                                     for g, r in zip(got, right, strict=True)):
+        return
+    causes = [cause for cause in mistakes[0]
+              if all(each.get(cause) is not None for each in mistakes)
+              and all(abs(g - each[cause]) <= TIME_ATOL < abs(each[cause] - r)
+                      for g, each, r in zip(got, mistakes, right, strict=True))]
+    if causes:
+        shown = " and ".join(f"{name} = {g:g} s" for name, g in zip(given, got, strict=True))
+        raise CheckFailed(f"{shown} are not right: {_either(causes)}")
 
 
 def _interval_parts(interval: object, name: str) -> tuple[object, object, object]:
