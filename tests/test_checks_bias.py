@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from check_outcomes import assert_fails, assert_passes
@@ -100,6 +102,27 @@ def signal_worth(*, mistake=""):
         return metrics.mean_ci95(alone.mean() - with_signal)
     if mistake == "mean signal":
         return metrics.mean_ci95(alone - with_signal.mean())
+    if mistake == "percent per run":
+        return metrics.mean_ci95(100 * (alone - with_signal) / alone)
+    if mistake == "percent of the signal's":
+        return metrics.mean_ci95(100 * (alone - with_signal) / with_signal)
+    if mistake == "rmse":
+        return metrics.mean_ci95(np.sqrt(alone) - np.sqrt(with_signal))
+    if mistake == "root":
+        right = metrics.mean_ci95(alone - with_signal)
+        return metrics.Interval(np.sqrt(right.mean), np.sqrt(right.low), np.sqrt(right.high),
+                                right.runs)
+    if mistake in ("burn-in + 1", "burn-in - 1"):
+        truth = DEFAULT.truth[:, 0]
+        start = DEFAULT.burn_in_steps + (1 if mistake.endswith("+ 1") else -1)
+        return metrics.mean_ci95(metrics.mse(vision_only.positions, truth, start)
+                                 - metrics.mse(mc.positions, truth, start))
+    if mistake == "shuffled":   # the runs out of their pairs
+        return metrics.mean_ci95(np.random.default_rng(0).permutation(alone) - with_signal)
+    if mistake == "another draw":
+        other = experiments.track(dataclasses.replace(DEFAULT, seed=DEFAULT.seed + 1),
+                                  runs=DEFAULT.mc_runs)
+        return metrics.mean_ci95(other.mse() - with_signal)
     return metrics.mean_ci95(alone - with_signal)
 
 
@@ -123,6 +146,17 @@ def test_the_signal_helps_so_the_improvement_is_positive():
     ("ratio", "it is a ratio of the MSEs"),
     ("mean vision", "one side is the mean MSE over the runs"),
     ("mean signal", "the other the mean MSE over the runs"),
+    ("percent per run", "is not right: it is in % of each run's vision-only MSE"),
+    ("percent of the signal's", "is not right: it is in % of each run's MSE with the signal"),
+    ("rmse", "is not right: it is the difference of the root mean squared errors (√MSE"),
+    ("root", "is not right: it is the square root of the interval of the MSE difference"),
+    ("burn-in + 1", "is not right: it leaves out one sample too many (101 instead of 100)"),
+    ("burn-in - 1", "is not right: it leaves out one sample too few (99 instead of 100)"),
+    ("shuffled", "is not right: its runs are not paired: the mean is right, but its width is "
+                 "that of two independent samples"),
+    # Here pairing narrows the interval little, so another draw is asked about, not asserted.
+    ("another draw", "and not by one of the usual mistakes: its mean and width are what "
+                     "another noise draw would give"),
 ])
 @pytest.mark.slow
 def test_check_signal_worth_names_each_realistic_mistake(mistake, phrase):

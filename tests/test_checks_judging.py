@@ -140,6 +140,32 @@ def test_runs_shuffled_out_of_their_pairs_are_named(runs) -> None:
     assert message.startswith("d: the mean (")
 
 
+def test_runs_of_another_draw_are_named_where_pairing_narrows_the_interval(runs) -> None:
+    """Given the per-run values, an interval over another draw (mean off by noise, the
+    unpaired width) is named as unpaired; the paired interval here is far narrower."""
+    first, second = runs
+    right = metrics.mean_ci95(first - second)
+    rng = np.random.default_rng(11)
+    other = rng.gamma(10.0, 0.1, size=first.size) + 0.1 + 0.01 * rng.normal(size=first.size)
+    unpaired = metrics.mean_ci95(other - second)
+    assert abs(unpaired.mean - right.mean) > 1e-3           # not the right mean
+    assert_fails("d (mean", judge_interval, "d", unpaired, right, 1e-9,
+                 runs_of=(first, second, "Pair them."))
+    message = assert_fails("is not right: its runs are not paired: its mean is within the "
+                           "spread of another noise draw", judge_interval, "d", unpaired,
+                           right, 1e-9, runs_of=(first, second, "Pair them."))
+    assert message.endswith("Pair them.")
+    # Without the per-run values nothing is claimed.
+    assert_fails("and not by one of the usual mistakes", judge_interval, "d", unpaired, right,
+                 1e-9)
+    # A mean far outside another draw's spread is not called unpaired.
+    shifted = metrics.Interval(unpaired.mean + 1.0, unpaired.low + 1.0, unpaired.high + 1.0,
+                               unpaired.runs)
+    message = assert_fails("and not by one of the usual mistakes", judge_interval, "d",
+                           shifted, right, 1e-9, runs_of=(first, second, "Pair them."))
+    assert "noise draw" not in message
+
+
 def test_judge_interval_names_what_is_not_an_interval(runs) -> None:
     first, second = runs
     right = metrics.mean_ci95(first - second)

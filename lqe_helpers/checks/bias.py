@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import bias_model, experiments, metrics
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge_interval
+from .judging import burn_in_slips, interval_mistakes, judge_interval
 from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
@@ -136,8 +136,9 @@ def _signal_worth() -> dict[str, object]:
     with_signal = bias_model.track_with_input(DEFAULT, runs=DEFAULT.mc_runs)
     vision = vision_runs()
     alone, helped = vision.mse(), with_signal.mse()
+    right = metrics.mean_ci95(alone - helped)
     return {
-        "right": metrics.mean_ci95(alone - helped),
+        "right": right,
         "mistakes": {
             **interval_mistakes(alone, helped, "the vision-only MSE",
                                 "the MSE with the signal"),
@@ -148,6 +149,17 @@ def _signal_worth() -> dict[str, object]:
                 metrics.mean_ci95(100 * (helped - alone) / alone.mean()),
             "it is a fraction of the vision-only MSE; the task asks for the difference in cm²":
                 metrics.mean_ci95((alone - helped) / alone.mean()),
+            "it is in % of each run's vision-only MSE; the task asks for the difference "
+            "itself, in cm²": metrics.mean_ci95(100 * (alone - helped) / alone),
+            "it is in % of each run's MSE with the signal; the task asks for the difference "
+            "itself, in cm²": metrics.mean_ci95(100 * (alone - helped) / helped),
+            "it is in % of the MSE with the signal; the task asks for the difference in cm²":
+                metrics.mean_ci95(100 * (alone - helped) / helped.mean()),
+            "it is the difference of the root mean squared errors (√MSE, in cm), run by run; "
+            "the task asks for the difference of the MSEs themselves, in cm²":
+                metrics.mean_ci95(np.sqrt(alone) - np.sqrt(helped)),
+            "it is the square root of the interval of the MSE difference (√ cm²); the task "
+            "asks for the difference of the MSEs itself, in cm²": _rooted(right),
             "each run's difference is divided by that run's vision-only MSE; the task asks "
             "for the difference itself, in cm²": metrics.mean_ci95((alone - helped) / alone),
             "it is a ratio of the MSEs; the task asks for their difference, in cm²":
@@ -165,8 +177,21 @@ def _signal_worth() -> dict[str, object]:
             "one side is the per-run MSEs, the other the mean MSE over the runs; pair the "
             "per-run MSEs run by run (vision_only.mse() − mc.mse())":
                 metrics.mean_ci95(alone - helped.mean()),
+            **{cause: metrics.mean_ci95(metrics.mse(vision.positions, truth, start)
+                                        - metrics.mse(with_signal.positions, truth, start))
+               for cause, start in burn_in_slips(DEFAULT.burn_in_steps, truth.size).items()},
         },
+        "runs_of": (alone, helped, "Make vision_only with experiments.track(DEFAULT, "
+                                   "runs=DEFAULT.mc_runs), which uses mc's camera noise, and "
+                                   "subtract mc.mse() from vision_only.mse() as they come"),
     }
+
+
+def _rooted(interval: metrics.Interval) -> metrics.Interval:
+    """The interval with the square root taken of its mean and ends (NaN where < 0)."""
+    with np.errstate(invalid="ignore"):
+        parts = np.sqrt([interval.mean, interval.low, interval.high])
+    return metrics.Interval(*(float(part) for part in parts), interval.runs)
 
 
 def check_signal_worth(improvement: metrics.Interval) -> None:
@@ -189,14 +214,16 @@ def check_signal_worth(improvement: metrics.Interval) -> None:
     Raises
     ------
     CheckFailed
-        With the likely cause: the difference the wrong way round, unpaired, in %, over
-        the whole trial, dead reckoning's MSE for the filter's, one vision-only run, ...
+        With the likely cause: the difference the wrong way round, unpaired (another noise
+        draw, runs out of order), in % of either MSE, the RMSE or its root, over the whole
+        trial or the burn-in a sample off, dead reckoning's MSE for the filter's, one
+        vision-only run, ...
     """
     right = _signal_worth()
     judge_interval("improvement", improvement, right["right"], INTERVAL_RTOL,
                    unit="cm²", what="the paired difference vision only − with the signal, "
                                     "recomputed from the task's inputs",
-                   mistakes=right["mistakes"])
+                   mistakes=right["mistakes"], runs_of=right["runs_of"])
     passed(f"vision only − with the signal, paired over {DEFAULT.mc_runs} runs: mean and 95 % "
            f"interval match the pack's engine on the task's draws to "
            f"{tolerance_text(INTERVAL_RTOL)} relative")

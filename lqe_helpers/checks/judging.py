@@ -226,7 +226,8 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
                    mistakes: Mapping[str, metrics.Interval | None] | None = None,
                    unit: str = "",
                    what: str = "the paired difference recomputed from the task's inputs",
-                   nan_hint: str = "") -> None:
+                   nan_hint: str = "",
+                   runs_of: tuple[np.ndarray, np.ndarray, str] | None = None) -> None:
     """Judge a student's mean with its 95 % interval against a recomputed one.
 
     Parameters
@@ -245,6 +246,12 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
         Likely mistakes (cause → the interval it gives), tried in order; see :func:`judge`.
     unit, what, nan_hint
         See :func:`judge`.
+    runs_of : (ndarray, ndarray, str), optional
+        The per-run values (runs,) of the two conditions and how to pair them, in words
+        ("Make vision_only with experiments.track(DEFAULT, runs=DEFAULT.mc_runs)"). Given,
+        an interval of runs that are not paired is named: the right mean, or a mean as
+        far from the right one as another noise draw puts it, with the width of two
+        independent samples (:data:`UNPAIRED_SPREAD`); see :func:`_unpaired`.
 
     Raises
     ------
@@ -279,6 +286,9 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
         if np.all(np.isfinite(wrong)) and not near(wrong, right) and near(got, wrong):
             raise CheckFailed(f"{name} is not right: {cause}")
     unit_text = f" {unit}" if unit else ""
+    cause, hint = _unpaired(got, right, near(got[:1], right[:1]), runs_of)
+    if cause:
+        raise CheckFailed(f"{name} (mean {got[0]:.6g}{unit_text}) is not right: {cause}")
     if near(got[:1], right[:1]):
         wider = (got[2] - got[1]) > 1.5 * (right[2] - right[1])
         raise CheckFailed(
@@ -292,7 +302,46 @@ def judge_interval(name: str, interval: object, expected: metrics.Interval, rtol
                "first"))
     raise CheckFailed(
         f"{name} (mean {got[0]:.6g}{unit_text}) does not match {what} (to "
-        f"{tolerance_text(rtol)} relative), and not by one of the usual mistakes")
+        f"{tolerance_text(rtol)} relative), and not by one of the usual mistakes"
+        f"{f': {hint}' if hint else ''}")
+
+
+#: How far (relative) the half-width of an interval may be from that of two independent
+#: samples, t √((s₁² + s₂²) / runs), to be taken for runs that are not paired.
+UNPAIRED_SPREAD = 0.25
+
+
+def _unpaired(got: np.ndarray, right: np.ndarray, mean_right: bool,
+              runs_of: tuple[np.ndarray, np.ndarray, str] | None) -> tuple[str, str]:
+    """(cause, hint) for an interval (mean, low, high) of runs that look not paired.
+
+    Its half-width is within :data:`UNPAIRED_SPREAD` of that of two independent samples
+    and its mean within their 95 % half-width of the right mean (where another draw puts
+    it). That is a cause if the mean is right (the runs out of their pairs) or the paired
+    interval is clearly narrower (the width tells pairing apart); else only a hint, a
+    question, since a slip that moves the mean a little looks the same.
+    """
+    if runs_of is None:
+        return "", ""
+    first, second, advice = runs_of
+    runs = first.size
+    half = metrics.t_critical_95(runs - 1) * float(
+        np.sqrt((np.var(first, ddof=1) + np.var(second, ddof=1)) / runs))
+    got_half, right_half = (got[2] - got[1]) / 2, (right[2] - right[1]) / 2
+    if not (half > 0 and abs(got_half / half - 1) <= UNPAIRED_SPREAD
+            and abs(got[0] - right[0]) <= half):
+        return "", ""
+    if mean_right or right_half < (1 - UNPAIRED_SPREAD) * half:
+        how = ("the mean is right, but" if mean_right
+               else "its mean is within the spread of another noise draw, and")
+        return (f"its runs are not paired: {how} its width is that of two independent "
+                f"samples (within "
+                f"{UNPAIRED_SPREAD:.0%}). Run r of both must be on the same noise draw, in "
+                f"the same order. {advice}"), ""
+    return "", (f"its mean and width are what another noise draw would give (the mean "
+                f"within ±{half:.3g}, the width that of two independent samples): are the "
+                f"runs paired, run r of both on the same noise draw, in the same order? "
+                f"{advice}")
 
 
 def _around(mean: float, half: float, runs: int) -> metrics.Interval:
