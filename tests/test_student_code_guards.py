@@ -60,12 +60,34 @@ def test_inputs_that_fit_run_the_students_function_unchanged(loaded):
                  r"R\[:1, :1\]\)"),
     (C2, R2[:1, :1], r"C has shape \(2, 3\); for 1 sensor .* it must be \(1, 3\): one row per "
                      r"sensor \(for vision alone, C\[:1\] with y\[:, :1\]\)"),
-    (C2, R2, r"C has shape \(2, 3\)"),       # both kept: numpy alone would run on silently
 ])
 def test_a_vision_only_run_with_both_senses_c_or_r_is_named(loaded, C, R, phrase):
     with pytest.raises(StudentCodeError, match=f"^my_filter was given inputs that do not fit: "
                                                f"{phrase}"):
         call(loaded, Y2[:, :1], C, R)
+
+
+def test_one_column_of_two_senses_readings_names_y_not_c(loaded):
+    """Issue 23: Y[:, :1] with both senses' C and R blamed C; C and R agree, y does not.
+    Both fixes are said: y of both senses, or C and R cut for vision alone."""
+    with pytest.raises(StudentCodeError, match=r"^my_filter was given inputs that do not fit: "
+                                               r"y has shape \(10, 1\), 1 column of readings, "
+                                               r"while C \(2, 3\) and R \(2, 2\) are for 2 "
+                                               r"sensors: with this C and R, y needs all 2 "
+                                               r"senses' readings, shape \(n, 2\)") as info:
+        call(loaded, Y2[:, :1], C2, R2)   # both kept: numpy alone would run on silently
+    assert "C[:1], R[:1, :1]" in str(info.value)
+
+
+def test_readings_made_from_the_whole_true_state_name_y_not_c(loaded):
+    """Issue 23: readings from the (n, 3) truth gave y 3 columns; the guard blamed C."""
+    truth, noise = np.arange(30.0).reshape(10, 3), np.ones((10, 1))
+    with pytest.raises(StudentCodeError, match=r"y has shape \(10, 3\), 3 columns of readings, "
+                                               r"while C \(1, 3\) and R \(1, 1\) are for 1 "
+                                               r"sensor: y must be \(n, 1\), one column per "
+                                               r"sensor\. Were the readings made from the "
+                                               r"whole true state"):
+        call(loaded, truth + 1.5 * noise, C2[:1], R2[:1, :1])
 
 
 def test_the_silent_broadcast_the_guard_prevents_is_real():

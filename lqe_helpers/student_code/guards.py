@@ -52,6 +52,9 @@ def filter_inputs_problem(y: object, A: object, C: object, Q: object, R: object,
         return (f"y has shape {shapes['y']}, one column per time step, while C is for "
                 f"{rows_of_c} sensor{'s' * (rows_of_c != 1)}: y must be (n, {rows_of_c}). An "
                 f"(n,) array added to an (n, 1) one makes (n, n): make both (n, 1) first")
+    problem = _readings_problem(shapes, rows_of_c, k)
+    if problem is not None:
+        return problem
     if shapes["C"] != (m, k):
         cut = (" (for vision alone, C[:1] with y[:, :1])"
                if m == 1 and len(shapes["C"]) == 2 and shapes["C"][0] > 1 else "")
@@ -66,6 +69,33 @@ def filter_inputs_problem(y: object, A: object, C: object, Q: object, R: object,
         if shapes[name] != needed:
             return f"{name} has shape {shapes[name]}; for {k} states it must be {needed}"
     return None
+
+
+def _readings_problem(shapes: dict[str, tuple[int, ...]], rows_of_c: int | None,
+                      k: int) -> str | None:
+    """y's columns against C and R that agree with each other: then y is the odd one out.
+
+    Either y lost senses (``Y[:, :1]`` with both senses' C and R: the fix is y of both,
+    or C and R cut to match) or gained columns (readings made from the whole true state
+    (n, k) instead of its position).
+    """
+    y, R = shapes["y"], shapes["R"]
+    m = y[1]
+    rows_of_r = R[0] if len(R) == 2 and R[0] == R[1] else None
+    if rows_of_c is None or rows_of_c != rows_of_r or rows_of_c == m:
+        return None
+    c = rows_of_c
+    start = (f"y has shape {y}, {m} column{'s' * (m != 1)} of readings, while C {shapes['C']} "
+             f"and R {R} are for {c} sensor{'s' * (c != 1)}")
+    if m < c:
+        return (f"{start}: with this C and R, y needs all {c} senses' readings, shape "
+                f"(n, {c}) (y itself, not y[:, :{m}]); for the first {m} sense"
+                f"{'s' * (m != 1)} alone, cut C and R to match: C[:{m}], R[:{m}, :{m}]")
+    whole_state = (f". Were the readings made from the whole true state, shape (n, {k}), "
+                   f"all {k} of its columns? A sense reads the position only: use its "
+                   f"position column (truth[:, :1], shape (n, 1))" if m == k and c == 1
+                   else "")
+    return f"{start}: y must be (n, {c}), one column per sensor{whole_state}"
 
 
 def compensate_inputs_problem(estimates: object, A: object, delay_steps: object) -> str | None:
