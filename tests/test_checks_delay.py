@@ -194,7 +194,7 @@ def task2(slip: str = "") -> tuple:
 
     Returns (late_readings, delayed, compensated).
     """
-    y, m = READINGS, VISION
+    y, m = (READINGS / 100 if slip == "metres" else READINGS), VISION
     steps = STEPS + (slip == "one sample late")
     late_y = simulation.delay_signal(y, steps)
     if slip == "filter the late readings":
@@ -244,6 +244,7 @@ def test_task2_inputs_are_those_of_the_engine() -> None:
     ("truth seen late", "late_readings is not right: it holds the true position seen late"),
     ("velocity column", "delayed is not right: it holds velocities (column 1 of the states"),
     ("A once", "compensated is not right: A is applied once, not δ times"),
+    ("metres", "late_readings is not right: the readings are in metres"),
     ("filter the late readings", "delayed is NaN at every sample, also after j = δ = 10: was "
                                  "your my_filter run on the late readings?"),
 ])
@@ -278,6 +279,16 @@ def test_check_delay_signals_asks_about_the_compensation_not_my_filter() -> None
     message = assert_fails("compensated does not match the signal recomputed",
                            checks.check_delay_signals, late, delayed, twisted)
     assert "which power of A moves it (A^δ" in message
+
+
+def test_check_delay_signals_names_the_estimates_of_readings_in_metres() -> None:
+    late, _, _ = task2()
+    _, delayed, compensated = task2("metres")
+    assert_fails("delayed is not right: the readings are in metres",
+                 checks.check_delay_signals, late, delayed, compensated)
+    right = task2()
+    assert_fails("compensated is not right: the readings are in metres",
+                 checks.check_delay_signals, late, right[1], compensated)
 
 
 def test_check_delay_signals_names_nan_in_the_wrong_places() -> None:

@@ -324,6 +324,8 @@ def task2(slip: str = ""):
             y = TRUTH + scale * NOISE[:, 0]                         # (n,)
         else:
             y = TRUTH[:, None] + scale * NOISE
+        if slip == "metres":
+            y = y / 100
         R = np.array([[{"R = sigma": sigma_v, "R = sigma^4": sigma_v**4,
                         "always 1.5": 1.5**2}.get(slip, sigma_v**2)]])
         estimates = student_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, R, np.zeros(3),
@@ -366,6 +368,7 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
                        "estimates"),
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),
     ("engine", "vision_trial runs the pack's own lqe_helpers.filter.kalman_filter"),
+    ("metres", "vision_trial(1.5) returns (the readings y) is not right: they are in metres"),
 ])
 def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_trial, task2(slip))

@@ -26,7 +26,7 @@ from ..scenario import DEFAULT
 from ..simulation import delay_signal
 from . import compensation_cases
 from .compensation_cases import COMPENSATE_ARGS, COMPENSATION_MISTAKES, Case, mistaken
-from .judging import interval_mistakes, judge_interval
+from .judging import CM_PER_M, interval_mistakes, judge_interval
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -218,6 +218,9 @@ def _trial() -> dict[str, object]:
 
     signals = {"late_readings": late(readings), "delayed": late(estimates),
                "compensated": ahead(estimates)}
+    metres = ("the readings are in metres (y divided by 100) while the model and the truth "
+              "are in cm: use the readings y as they are, in cm")
+    in_metres = experiments.filter_model(DEFAULT).filter(readings / CM_PER_M).estimates
     off_by_one = {"the delay is one sample too long (δ + 1)": steps + 1,
                   "the delay is one sample too short (δ − 1)": steps - 1}
     wrapped = ("it was shifted with np.roll, which wraps the last δ samples round to the "
@@ -234,6 +237,7 @@ def _trial() -> dict[str, object]:
             "it holds the true position seen late, not the noisy readings y seen late":
                 delay_signal(truth, steps, axis=-1),
             **{cause: late(readings, shift) for cause, shift in off_by_one.items()},
+            metres: late(readings / CM_PER_M),
         },
         "delayed": {
             "it is not delayed: these are the estimates as the filter made them, ẑ_j. At "
@@ -243,6 +247,7 @@ def _trial() -> dict[str, object]:
             "it holds the compensated estimate, not the delayed one": signals["compensated"],
             velocities: late(estimates, column=1),
             **{cause: late(estimates, shift) for cause, shift in off_by_one.items()},
+            metres: late(in_metres),
         },
         "compensated": {
             "compensate was given the delayed estimates, so it predicts from 2δ samples "
@@ -255,6 +260,7 @@ def _trial() -> dict[str, object]:
                 (delay_signal(estimates, steps) @ DEFAULT.A.T)[:, 0],
             velocities: ahead(estimates, column=1),
             **{cause: ahead(estimates, shift) for cause, shift in off_by_one.items()},
+            metres: ahead(in_metres),
         },
     }
     return {"signals": signals, "signal_mistakes": signal_mistakes, "steps": steps}

@@ -24,7 +24,7 @@ from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
 from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
-from .judging import judge
+from .judging import CM_PER_M, judge
 from .machinery import (
     FUNCTION_RTOL,
     CheckFailed,
@@ -253,6 +253,8 @@ def _trial(sigma_v: float) -> dict[str, object]:
             f"vision_trial is given": _readings(other),
             "they are the noise alone (σ_v · noise): add the true position":
                 _readings(sigma_v) - DEFAULT.truth[:, :1],
+            "they are in metres (divided by 100): the truth, σ_v, R and Q are in cm, so the "
+            "readings are too": _readings(sigma_v) / CM_PER_M,
         },
         "estimate_mistakes": {
             "R holds σ_v (cm) where its variance σ_v² (cm²) belongs, so the filter weighs "
