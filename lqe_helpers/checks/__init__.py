@@ -26,8 +26,9 @@ every ``check_…`` and the tolerances:
   ``bias`` (06; its Going further in ``bias_further``);
 - ``machinery``: :class:`CheckFailed`, the tolerances, calling the student's code,
   validating what a student passes;
-- ``judging``: :func:`judging.judge`, :func:`judging.judge_interval` and the usual
-  mistakes of an MSE and of a paired difference;
+- ``judging``: :func:`judging.judge`, :func:`judging.judge_interval`,
+  :func:`judging.judge_seconds` (a time read off a curve) and the usual mistakes of an
+  MSE, a burn-in and a paired difference;
 - ``shared_runs``: the engine's Monte Carlo runs that checks of several notebooks compare
   with, made once per kernel.
 """
