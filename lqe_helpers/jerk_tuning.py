@@ -70,9 +70,11 @@ class JerkChoice:
 
     @property
     def by_likelihood_per_run(self) -> np.ndarray:
-        """The grid σ_j each single run's likelihood picks, shape (runs,): what one
-        observer with one trial would choose."""
-        return self.jerk_stds[np.argmax(self.log_likelihood, axis=1)]
+        """The σ_j (cm/s³) each single run's likelihood picks, shape (runs,): what one
+        observer with one trial would choose; refined between grid points by a parabola
+        in ln σ_j, as :attr:`by_likelihood`."""
+        return np.array([_refined_extreme(self.jerk_stds, run, largest=True)
+                         for run in self.log_likelihood])
 
 
 def _refined_extreme(grid: np.ndarray, values: np.ndarray, largest: bool) -> float:

@@ -17,15 +17,11 @@ def matched_jerk_std(amplitude: float, frequency: float, dt: float,
                      period_fraction: float = 0.25) -> float:
     """Jerk noise σ_j (cm/s³) whose random walk matches the sinusoid's change of acceleration.
 
-    The filter does not know the butterfly flies a sinusoid; it treats the jerk as
-    white noise held over each step, so its acceleration performs a random walk whose
-    variance grows as ``σ_j² Δt · T`` over a time T. The real acceleration of
-    ``A sin(ωt)`` swings by its amplitude ``A ω²`` in a quarter period ``T = 1/(4f)``.
-    Equating the two spreads gives ``σ_j = A ω² / √(Δt T)``. The motion fixes
-    the form of Q (``G σ_j² Gᵀ``) and the order of magnitude of σ_j; the time scale is
-    a modelling choice, not physics: an eighth, a half or a whole period instead of a
-    quarter gives σ_j larger by √2 or smaller by √2 or 2. The quarter period lands near
-    the Monte Carlo MSE optimum (``tests/test_lessons.py`` checks this).
+    The filter treats the jerk as white noise held over each step, so its
+    acceleration performs a random walk whose spread (standard deviation) after a time
+    T is ``σ_j √(Δt T)``. This function sets that spread equal to the amplitude ``A ω²`` of the
+    acceleration of ``A sin(ωt)`` (``ω = 2π f``) over ``T = period_fraction / f`` and
+    returns ``σ_j = A ω² / √(Δt T)``.
 
     Parameters
     ----------

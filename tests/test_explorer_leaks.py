@@ -157,6 +157,36 @@ def test_no_explorer_at_its_defaults_shows_a_number_its_notebooks_tasks_print(na
     assert leaks(shown, givens(slider_values(explorer)), answers) == [], explorer.numbers
 
 
+#: Views the notebook's Explore section sends the student to, before the Going further
+#: tasks that compute their numbers: (notebook, slider values). At σ_p = 4.5 cm 04's
+#: explorer gave proprioception's weight, 10.0 %, which its Going further 1 computes
+#: (issue 23 §5).
+DIRECTED_VIEWS = [("04_noisier_proprioception", {"sigma_p": 4.5})]
+
+
+def explore_section(name: str) -> str:
+    """The markdown of notebook ``name``'s "## Explore" cell."""
+    notebook = json.loads((NOTEBOOKS / f"{name}.ipynb").read_text(encoding="utf-8"))
+    return next("".join(cell["source"]) for cell in notebook["cells"]
+                if cell["cell_type"] == "markdown" and "".join(cell["source"]).startswith(
+                    "## Explore"))
+
+
+@pytest.mark.parametrize(("name", "values"), DIRECTED_VIEWS,
+                         ids=[case[0] for case in DIRECTED_VIEWS])
+@pytest.mark.slow
+def test_a_view_the_explore_section_asks_for_shows_no_number_a_task_prints(name, values) -> None:
+    module, factory = EXPLORERS[name]
+    section = explore_section(name)
+    assert all(f"{value:g} cm" in section for value in values.values()), section
+    explorer = getattr(module, factory)()
+    for key, value in values.items():
+        explorer.sliders[key].value = value
+    assert explorer.values == values and explorer.numbers
+    shown = " ".join([explorer.numbers, *figure_texts(explorer.figure)])
+    assert leaks(shown, givens(slider_values(explorer)), answers_of(name)) == [], explorer.numbers
+
+
 #: (notebook, draw function, the task's values) where the tasks' draw used to show.
 TASK_VALUES = [
     ("00_background_model", background.draw_background,
@@ -164,7 +194,7 @@ TASK_VALUES = [
     ("01_vision_only", vision.draw_vision, {"sigma_v": 1.5}, "2.04"),
     ("03_fusion", fusion.draw_fusion, {"sigma_v": 1.5, "sigma_p": 1.5}, "0.1596"),
     ("04_noisier_proprioception", noisier_proprioception.draw_noisier_proprioception,
-     {"sigma_p": 4.5}, "10.0"),
+     {"sigma_p": 4.5}, "0.3042"),
 ]
 # 05 is not here: its tasks print no one-run MSE (its explorer's numbers line) any more.
 

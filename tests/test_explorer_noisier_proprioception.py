@@ -74,10 +74,14 @@ def _check_figure(figure: Figure, numbers: str, sigma_p: float, noise: np.ndarra
     skip = scenario.burn_in_steps
     mse_vision, mse_fused = (np.mean((estimate[skip:] - truth[skip:]) ** 2)
                              for estimate in (alone, both))
+    # At question (d)'s σ_p the weight is withheld: Going further 1 computes it (issue 23 §5).
+    weight_text = (f"Proprioception's weight in the steady state at σ_p = {QUESTION_SIGMA_P:g} cm: "
+                   f"Going further 1 asks you to compute it." if sigma_p == QUESTION_SIGMA_P
+                   else f"Proprioception's weight in the steady state: {_sig(100 * weight, 3)} %.")
     assert numbers == (f"σ_v = {sigma_v:g} cm, σ_p = {sigma_p:g} cm. MSE of this trial after "
                        f"{scenario.burn_in:g} s: vision only {_sig(mse_vision, 4)} cm², "
-                       f"fused {_sig(mse_fused, 4)} cm². Proprioception's weight in the "
-                       f"steady state: {_sig(100 * weight, 3)} %. Estimates from {whose}."), numbers
+                       f"fused {_sig(mse_fused, 4)} cm². {weight_text} Estimates from "
+                       f"{whose}."), numbers
     assert figure.get_suptitle() == ""
     assert figure.axes[2].get_title() == THEORY_TITLE
 

@@ -44,6 +44,16 @@ def test_refinement_finds_a_parabolas_vertex_and_a_linear_crossing() -> None:
     assert np.isnan(flat.by_nis)
 
 
+def test_each_runs_pick_is_refined_between_grid_points() -> None:
+    """Issue 23 §5: one run's pick was a grid point, so a range of picks was two grid points."""
+    grid = np.geomspace(100, 10_000, 9)
+    peaks = np.array([[777.0], [1500.0], [250.0]])
+    choice = jerk_tuning.JerkChoice(
+        jerk_stds=grid, nis_mean=np.ones(9),
+        log_likelihood=-(np.log(grid) - np.log(peaks)) ** 2, mse=np.zeros((3, 9)), sensors=1)
+    np.testing.assert_allclose(choice.by_likelihood_per_run, peaks[:, 0], rtol=1e-9)
+
+
 @pytest.mark.slow
 def test_likelihood_and_nis_choose_near_the_mse_optimum_without_the_truth() -> None:
     # Measured on DEFAULT (300 runs, grid 300–6 000 cm/s³): likelihood 1 346, NIS 1 185,

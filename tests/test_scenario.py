@@ -103,3 +103,11 @@ def test_bad_values_are_refused(change: dict, message: str) -> None:
 def test_unit_noise_refuses_unknown_sensors() -> None:
     with pytest.raises(ValueError, match="sensors must be distinct names"):
         DEFAULT.unit_noise(sensors=("touch",))
+
+
+def test_matched_jerk_std_says_what_it_computes_not_question_3s_conclusion() -> None:
+    """Issue 23 §5: the docstring ships to students before 00's Question 3 answers it."""
+    doc = " ".join(matched_jerk_std.__doc__.split())
+    assert "σ_j = A ω² / √(Δt T)" in doc
+    for conclusion in ("modelling choice", "not physics", "optimum", "MSE", "order of magnitude"):
+        assert conclusion not in doc, conclusion

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from lqe_helpers import experiments, metrics, smoothing
+from lqe_helpers import experiments, fixed_gain, jerk_tuning, metrics, smoothing
 from lqe_helpers.scenario import DEFAULT
 
 pytestmark = pytest.mark.slow
@@ -81,3 +81,69 @@ def test_05_compensation_wins_back_57_percent_of_the_delays_cost() -> None:
                                     delayed.mse("predicted").mean(), tracking.mse().mean())
     share = (late - compensated) / (late - undelayed)
     assert round(100 * share, 1) == 56.7
+
+
+# ---------------------------------------------------------------- issue 23 §5, the review
+
+
+def test_01_filtering_lowers_the_mse_in_every_run(vision_batch) -> None:
+    """01's answer (a) says "every run" because its count cell prints 300 of 300."""
+    below = np.sum(vision_batch.mse() < vision_batch.measurement_mse("vision"), axis=0)
+    assert below.tolist() == [RUNS, RUNS]
+
+
+def test_01_the_lqe_averages_harder_than_the_smoother_at_1_5_cm_slightly_less_at_4_5(
+        vision_batch) -> None:
+    """01's "What does the model of motion buy?": the noise parts part 2 prints."""
+    alphas = np.linspace(0.02, 0.6, 30)                 # 01's grid
+    noise = {}
+    for i, sigma in enumerate((1.5, 4.5)):
+        tuned = smoothing.tune_smoother("exponential", vision_batch.measurements[:, i, :, 0],
+                                        TRUTH, alphas, BURN)
+        clean = smoothing.exponential_smoother(TRUTH, tuned.best)
+        lqe_clean = experiments.track(DEFAULT, sigmas=[sigma],
+                                      noise=np.zeros((DEFAULT.n_steps, 1))).positions
+        noise[sigma] = (np.mean((tuned.smoothed[:, BURN:] - clean[BURN:]) ** 2),
+                        np.mean((vision_batch.positions[:, i, BURN:] - lqe_clean[BURN:]) ** 2))
+    smoother, lqe = noise[1.5]
+    assert lqe < 0.8 * smoother                          # harder at 1.5 cm
+    smoother, lqe = noise[4.5]
+    assert smoother < lqe < 1.1 * smoother               # slightly less at 4.5 cm
+    assert (round(smoother, 2), round(lqe, 2)) == (2.00, 2.16)
+
+
+def test_01_a_fixed_gain_tuned_on_the_truth_does_slightly_better_than_the_lqe(
+        vision_batch) -> None:
+    """01's Going further 1: the tuned fixed gain wins by a small margin whose interval lies
+    below zero at both σ_v; at 4.5 cm even the fixed K∞ beats the LQE after the first second."""
+    for i, sigma in enumerate((1.5, 4.5)):
+        model = experiments.filter_model(DEFAULT, ("vision",), [sigma])
+        tuned = fixed_gain.tune_fixed_gain(vision_batch.measurements[:, i], model.A, model.C,
+                                           model.z0, TRUTH, model.steady_state().gain, BURN)
+        lqe = vision_batch.mse()[:, i]
+        margin = metrics.mean_ci95(tuned.mse - lqe)
+        assert margin.high < 0 and -margin.mean < 0.05 * lqe.mean()
+        if sigma == 4.5:
+            assert metrics.mean_ci95(tuned.start_mse - lqe).high < 0
+
+
+def test_00_01_what_the_readings_and_the_truth_pick_for_sigma_j() -> None:
+    """00's Going further E and 01's Going further 1, on 00's grid: the matched σ_j lies a few
+    per cent above the MSE's optimum; one run's likelihood picks within a tenth of it (95 %
+    of runs, refined between grid points); the NIS's choice lies more than a tenth below."""
+    choice = jerk_tuning.tune_jerk_std(DEFAULT, np.geomspace(700.0, 2800.0, 17))
+    best = choice.by_mse
+    assert round(best) == 1339 and round(DEFAULT.process_jerk_std) == 1396
+    assert 0 < DEFAULT.process_jerk_std / best - 1 < 0.05
+    low, high = np.percentile(choice.by_likelihood_per_run, [2.5, 97.5])
+    assert -0.1 < low / best - 1 < 0 < high / best - 1 < 0.1
+    assert -0.15 < choice.by_nis / best - 1 < -0.1
+    assert round(100 * (choice.by_nis / best - 1)) == -12
+
+
+def test_02_after_2_s_the_two_p0s_differ_by_less_than_1e_5_of_the_mse() -> None:
+    batch = experiments.track(DEFAULT, p0_variance=[1.0, 1e5], runs=RUNS)
+    late = metrics.mse(batch.positions, TRUTH, 2 * BURN)                 # (runs, 2)
+    difference = metrics.mean_ci95(late[:, 0] - late[:, 1])
+    largest = max(abs(difference.low), abs(difference.high)) / late[:, 1].mean()
+    assert difference.low < 0 < difference.high and largest < 1e-5

@@ -264,6 +264,66 @@ def printed_before_the_tasks(notebook: nbformat.NotebookNode) -> list[str]:
     return leaks
 
 
+def set_up_leaks(paths: list[Path]) -> list[str]:
+    """Results a notebook prints before its first task that another notebook's core tasks
+    compute (issue 23 §5: 01's set-up printed the σ_j that 00's Task 3 derives).
+
+    A student may open any notebook first, so its set-up cells (code cells above its
+    first task) must not print a core-path result of another notebook: a number that
+    notebook's code cells print from its first task to its "## Going further". The
+    question's numbers and typed inputs of both notebooks are excepted.
+    """
+    def split(notebook: nbformat.NotebookNode) -> tuple[dict, dict, set]:
+        allowed = {number_value(token) for token in numbers(question_text(notebook))}
+        allowed |= code_literals(notebook)
+        first_task = next((index for index, cell in enumerate(notebook.cells)
+                           if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
+        core_end = next((index for index, cell in enumerate(notebook.cells)
+                         if cell.cell_type == "markdown"
+                         and re.search(r"^##\s+Going further", cell.source, re.M | re.I)),
+                        len(notebook.cells))
+        early: dict[Decimal, str] = {}
+        core: dict[Decimal, str] = {}
+        for index, cell in enumerate(notebook.cells[:core_end]):
+            if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+                continue
+            for output in cell.get("outputs", []):
+                for value in results(output_text(output)) - allowed:
+                    (early if index < first_task else core).setdefault(
+                        value, se.cell_place("source", index, cell))
+        return early, core, allowed
+
+    parts = {path.stem: split(nbformat.read(path, as_version=4)) for path in paths}
+    leaks = []
+    for name, (early, _, _) in parts.items():
+        for other, (_, core, allowed) in parts.items():
+            if other != name:
+                leaks += [f"{name} {early[value]} prints {value} before its tasks; "
+                          f"{other} {core[value]} computes it"
+                          for value in sorted(set(early) & set(core) - allowed)]
+    return leaks
+
+
+def test_a_set_up_printing_another_notebooks_result_is_found(tmp_path):
+    """01's set-up as it was, beside 00: it printed 00's Task 3 σ_j."""
+    stub = leak_fixture()
+    stub.cells[2].outputs[0].text = "σ_j = 1,396 cm/s³\n"
+    setup = new_code_cell("print(sigma_j)", execution_count=1, outputs=[
+        new_output("stream", name="stdout", text="jerk noise behind Q: σ_j = 1396 cm/s³\n")])
+    later = leak_fixture()
+    later.cells.insert(1, setup)
+    nbformat.write(stub, tmp_path / "00_fixture.ipynb")
+    nbformat.write(later, tmp_path / "01_fixture.ipynb")
+    leaks = set_up_leaks([tmp_path / "00_fixture.ipynb", tmp_path / "01_fixture.ipynb"])
+    assert [leak.split(";")[0] for leak in leaks] == [
+        f"01_fixture {se.cell_place('source', 1, setup)} prints 1396 before its tasks"]
+
+
+def test_no_set_up_prints_a_result_another_notebooks_core_tasks_compute():
+    leaks = set_up_leaks(NOTEBOOKS)
+    assert not leaks, "\n".join(leaks)
+
+
 def student_of(notebook: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
     return nbformat.reads(se.student_edition(notebook, name), as_version=4)
 

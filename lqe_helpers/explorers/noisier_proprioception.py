@@ -18,6 +18,7 @@ state, which does not depend on the readings.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from functools import partial
 from typing import NamedTuple
@@ -47,11 +48,11 @@ from .panels import pin_axis_labels, reuse_panels
 from .sliders import float_slider
 from .student_functions import checked_function, refiltered, whose
 
-#: σ_p (cm) of question (d).
+#: σ_p (cm) of question (d). The numbers line does not give proprioception's weight at
+#: this σ_p (10.0 %): Going further 1 of notebook 04 asks for it, and the Explore
+#: section sends the student to this σ_p before it (issue 23 §5).
 QUESTION_SIGMA_P = 4.5
-#: Where the slider starts (cm): near question (d)'s σ_p, not at it. At 4.5 cm the
-#: numbers line would give proprioception's steady-state weight, 10.0 %, the answer of
-#: a task in notebook 04 (issue 15).
+#: Where the slider starts (cm): near question (d)'s σ_p, not at it (issue 15).
 START_SIGMA_P = 6.0
 
 #: Slider range for σ_p (cm): low, high, step; 1.5 and 4.5 cm lie on the grid.
@@ -118,8 +119,9 @@ def draw_noisier_proprioception(figure: Figure, *, sigma_p: float,
     true position). Right: the fused filter's theoretical steady-state position
     variance against σ_p (log axis), the vision-only level, and a marker at
     ``sigma_p``. Returns both σ's, this trial's MSEs after the scenario's burn-in,
-    proprioception's share of the settled position gain and whose filter made the
-    estimates as one line of text (the explorer shows it beside the figure), e.g.
+    proprioception's share of the settled position gain (withheld at question (d)'s
+    σ_p, :data:`QUESTION_SIGMA_P`) and whose filter made the estimates as one line of
+    text (the explorer shows it beside the figure), e.g.
     "σ_v = 1.5 cm, σ_p = 6 cm. MSE of this trial after 1 s: vision only 0.4450 cm²,
     fused 0.4200 cm². Proprioception's weight in the steady state: 5.88 %. Estimates
     from your my_filter." (the explorer's draw).
@@ -203,8 +205,16 @@ def _draw(figure: Figure, *, sigma_p: float, scenario: Scenario, noise: np.ndarr
         panels.trial.lines[gid].set_ydata(values)
     panels.marker.set_data([sigma_p], [theory_now])
     return (f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} "
-            f"Proprioception's weight in the steady state: {significant(100 * weight_p, 3)} %. "
-            f"Estimates from {whose(filter)}.")
+            f"{_weight_text(sigma_p, weight_p)} Estimates from {whose(filter)}.")
+
+
+def _weight_text(sigma_p: float, weight_p: float) -> str:
+    """Proprioception's steady-state weight (a fraction) as the numbers line gives it:
+    withheld at question (d)'s σ_p, where a task of Going further 1 computes it."""
+    if math.isclose(sigma_p, QUESTION_SIGMA_P, rel_tol=1e-9):
+        return (f"Proprioception's weight in the steady state at σ_p = {QUESTION_SIGMA_P:g} cm: "
+                f"Going further 1 asks you to compute it.")
+    return f"Proprioception's weight in the steady state: {significant(100 * weight_p, 3)} %."
 
 
 class _Panels(NamedTuple):
