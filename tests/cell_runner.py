@@ -60,7 +60,8 @@ class CellRunner:
             exec(compile(source, filename, "exec"), self.namespace)
         except Exception as caught:  # a cell's error, as IPython reports it
             error = caught
-        self.events.trigger("post_run_cell", SimpleNamespace(success=error is None))
+        self.events.trigger("post_run_cell",
+                            SimpleNamespace(success=error is None, error_in_exec=error))
         return error
 
     def close(self) -> None:

@@ -10,6 +10,7 @@ check cell. Where the loophole gives the right values, the same cells without th
 from __future__ import annotations
 
 import contextlib
+import inspect
 import io
 
 import numpy as np
@@ -188,6 +189,18 @@ def test_a_one_trial_value_not_from_my_filter_fails(folder) -> None:
         error), error
 
 
+@pytest.mark.slow
+def test_a_slip_with_my_filters_output_still_gets_its_named_cause(folder) -> None:
+    """The velocity column of my_filter's estimates came from my_filter: the check names it."""
+    code = ("fused_positions = my_filter(y, A, C, Q, R, z0, P0)[:, 1]\n"
+            "vision_positions = my_filter(y[:, :1], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]\n"
+            "mse_fused_trial = float(metrics.mse(fused_positions, truth, burn_in))\n"
+            "mse_vision_trial = float(metrics.mse(vision_positions, truth, burn_in))\n")
+    error, _ = run_task("03_fusion", "check_fusion_trial", code)
+    assert "fused_positions is not right: it is column 1 of the estimates, the velocity" in str(
+        error), error
+
+
 # ------------------------------------------------------------------------------------------
 # §1, function tasks: any function of the pack, at any depth
 # ------------------------------------------------------------------------------------------
@@ -227,6 +240,16 @@ def test_a_function_task_that_runs_any_function_of_the_pack_fails(check, functio
     """The issue's cases, each the right answer: an old per-check forbid list missed them."""
     given = (eyes_closed()[0],) if check is checks.check_eyes_closed else ()
     assert_fails(f"runs the pack's own {named}", check, function, *given)
+
+
+def test_a_function_task_may_call_the_students_own_loaded_function(folder, capsys) -> None:
+    """01 Task 2 calls the saved my_filter: its wrappers (guard, call record) are no answer."""
+    from lqe_helpers import student_code
+
+    error, printed = run_task("01_vision_only", "check_vision_trial", None)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    loaded = student_code.load("my_filter")
+    assert inspect.unwrap(loaded).__module__ == "my_functions.my_filter"
 
 
 # ------------------------------------------------------------------------------------------
@@ -271,6 +294,11 @@ def test_a_name_the_check_cell_passes_that_no_cell_made_is_one_line(folder):
         message = task_runs.missing_name_message(error, error.__traceback__)
         assert message == ("name 'C' is not defined: the task cell that makes C stopped with "
                            "an error before making it: fix it and run it again, then this check")
+        runner.namespace.update(C=np.eye(2), R=np.eye(2))  # earlier values: not judged
+        error = runner.run(check_cell)
+        assert str(error) == ("the task cell above is not written yet: replace its line `raise "
+                              "NotImplementedError` with your code, run that cell, then this "
+                              "check again")
         error = runner.run("print(undefined_name)\n")      # not a check cell: IPython's own
         assert task_runs.missing_name_message(error, error.__traceback__) is None
     finally:

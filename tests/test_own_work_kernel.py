@@ -9,7 +9,6 @@ worked cell passes; a name no cell made is one line in the check cell.
 from __future__ import annotations
 
 import pytest
-
 from test_student_code_kernel import error_of, run
 
 pytestmark = pytest.mark.kernel

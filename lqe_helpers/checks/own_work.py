@@ -87,15 +87,15 @@ TOP_LEVEL: dict[str, tuple[str, ...]] = {
 class Produced:
     """A value a check is given that the student's saved function must have produced.
 
-    ``position`` is the argument's index in the check's call; ``column`` 0 if the value is
-    the position column of the function's output (None: the whole output); ``delayed`` if
-    it is that column shifted by a delay (its leading NaN rows).
+    ``position`` is the argument's index in the check's call. The value must equal one
+    recorded output of ``function`` in the task cell, whole or one column of it (a wrong
+    column is the check's to name), or (``delayed``) such a column shifted by a delay (its
+    leading NaN rows).
     """
 
     position: int
     name: str
     function: str
-    column: int | None = None
     delayed: bool = False
 
 
@@ -104,12 +104,12 @@ class Produced:
 DRIVEN: dict[str, tuple[Produced, ...]] = {
     "check_start_of_trial": (Produced(2, "estimates_small", "my_filter"),
                              Produced(3, "estimates_large", "my_filter")),
-    "check_fusion_trial": (Produced(0, "vision_positions", "my_filter", column=0),
-                           Produced(1, "fused_positions", "my_filter", column=0)),
-    "check_noisier_trial": (Produced(0, "vision_positions", "my_filter", column=0),
-                            Produced(1, "fused_positions", "my_filter", column=0)),
-    "check_delay_signals": (Produced(1, "delayed", "my_filter", column=0, delayed=True),
-                            Produced(2, "compensated", "compensate", column=0)),
+    "check_fusion_trial": (Produced(0, "vision_positions", "my_filter"),
+                           Produced(1, "fused_positions", "my_filter")),
+    "check_noisier_trial": (Produced(0, "vision_positions", "my_filter"),
+                            Produced(1, "fused_positions", "my_filter")),
+    "check_delay_signals": (Produced(1, "delayed", "my_filter", delayed=True),
+                            Produced(2, "compensated", "compensate")),
 }
 
 RERUN = "fix it and run it again, then this check"
@@ -130,30 +130,46 @@ def forbidden_calls(check: str, run: task_runs.TaskRun) -> list[str]:
                               if any(covers(entry, name) for entry in entries)))
 
 
+def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray]:
+    """What a value made from ``output`` may be: it whole, or one of its columns, (delayed:)
+    shifted ``late`` rows down behind NaN."""
+    found = [output] + [output[..., column] for column in range(output.shape[-1])
+                        if output.ndim >= 2]
+    if delayed:
+        found = [np.concatenate([np.full((late, *part.shape[1:]), np.nan),
+                                 part[: len(part) - late]]) for part in found if part.ndim]
+    return found
+
+
 def _produced_by(value: object, wanted: Produced, run: task_runs.TaskRun) -> bool:
     try:
         value = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        return True  # not an array: the check itself says what is wrong with it
+        return True  # not an array of numbers: the check itself says what is wrong with it
+    if value.ndim == 0:
+        return True
+    missing = np.isnan(value).reshape(len(value), -1).all(axis=1)
+    late = int(np.argmin(missing)) if not missing.all() else len(value)
     for call in run.saved_calls:
         if call.name != wanted.function:
             continue
         try:
             output = np.asarray(call.output, dtype=float)
-            if wanted.column is not None:
-                output = output[..., wanted.column]
-        except (TypeError, ValueError, IndexError):
+        except (TypeError, ValueError):
             continue
-        if wanted.delayed and value.ndim == 1 and output.shape == value.shape:
-            late = int(np.argmax(~np.isnan(value))) if (~np.isnan(value)).any() else 0
-            output = np.concatenate([np.full(late, np.nan), output[: len(output) - late]])
-        if close(value, output, FUNCTION_RTOL):
+        if output.ndim == 0 or len(output) != len(value):
+            continue
+        if any(close(value, candidate, FUNCTION_RTOL)
+               for candidate in _candidates(output, wanted.delayed, late)):
             return True
     return False
 
 
 def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
     """What makes ``check``'s values not the current task cell's own work, or None."""
+    if run.not_written:
+        return ("the task cell above is not written yet: replace its line `raise "
+                "NotImplementedError` with your code, run that cell, then this check again")
     if not run.completed:
         return (f"the task cell above stopped with an error: {RERUN} (it judges what that "
                 f"cell makes, not the values of an earlier run)")

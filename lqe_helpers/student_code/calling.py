@@ -248,8 +248,11 @@ _MACHINERY_CODES: set[types.CodeType] = set()
 
 
 def machinery_function(function: Callable) -> Callable:
-    """Mark ``function`` (of the pack) as machinery a student's function may run through."""
-    _MACHINERY_CODES.add(_code_of(function, "function"))
+    """Mark ``function`` (of the pack) as machinery a student's function may run through.
+
+    Its own code, not what it wraps (a wrapper's ``__wrapped__`` is the student's function).
+    """
+    _MACHINERY_CODES.add(function.__code__)  # type: ignore[attr-defined]
     return function
 
 

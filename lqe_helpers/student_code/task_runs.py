@@ -62,6 +62,8 @@ class TaskRun:
         Identifiers its ``# Task:`` comment names.
     completed : bool or None
         Whether it ran to its end without an error; None while it runs.
+    not_written : bool
+        Whether it stopped with ``NotImplementedError`` (a student edition's stub).
     pack_calls : dict
         Qualified name of each function of the pack it ran, by code object.
     saved_calls : list of SavedCall
@@ -73,6 +75,7 @@ class TaskRun:
     defines: frozenset[str]
     mentions: frozenset[str]
     completed: bool | None = None
+    not_written: bool = False
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
     saved_calls: list[SavedCall] = field(default_factory=list)
 
@@ -168,6 +171,8 @@ class _Record:
         run = self._stop()
         if run is not None:
             run.completed = bool(getattr(result, "success", False))
+            run.not_written = isinstance(getattr(result, "error_in_exec", None),
+                                         NotImplementedError)
 
     def _stop(self) -> TaskRun | None:
         run, self.current = self.current, None
@@ -261,6 +266,7 @@ def calls_a_check(source: str) -> bool:
         for node in ast.walk(tree))
 
 
+@machinery_function
 def note_call(name: str, args: tuple, output: object) -> None:
     """Record a call of the loaded function ``name`` in the task cell running now, if any."""
     run = _RECORD.current
