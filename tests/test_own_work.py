@@ -83,9 +83,9 @@ LOOPHOLES = {
         "import dataclasses\n"
         "P0_small = np.diag([1.0, 1.0, 1.0])\n"
         "P0_large = np.diag([1e5, 1e5, 1e5])\n"
-        "engine = experiments.filter_model(DEFAULT)\n"
-        "estimates_small = dataclasses.replace(engine, P0=P0_small).filter(y).estimates\n"
-        "estimates_large = dataclasses.replace(engine, P0=P0_large).filter(y).estimates\n",
+        "large = dataclasses.replace(DEFAULT, p0_variance=1e5)\n"
+        "estimates_small = experiments.track(DEFAULT).result.estimates\n"
+        "estimates_large = experiments.track(large).result.estimates\n",
         "lqe_helpers.filter.kalman_filter"),
     "03 Task 1, C and R from the model": (
         "03_fusion", "check_fusion",
@@ -286,19 +286,27 @@ def test_a_name_the_check_cell_passes_that_no_cell_made_is_one_line(folder):
         error = runner.run(check_cell)                      # the task cell never ran
         assert isinstance(error, NameError)
         message = task_runs.missing_name_message(error, error.__traceback__)
-        assert message == ("name 'C' is not defined: the task cell above this check makes it. "
-                           "Write that cell and run it, then this check again")
+        assert message == ("name 'C' is not defined: no cell run so far makes it. Run the "
+                           "cells above this check in order, its task cell too, then this check "
+                           "again")
         stub = task_comment(task) + "raise NotImplementedError\n"
         assert isinstance(runner.run(stub), NotImplementedError)
         error = runner.run(check_cell)
         message = task_runs.missing_name_message(error, error.__traceback__)
-        assert message == ("name 'C' is not defined: the task cell that makes C stopped with "
-                           "an error before making it: fix it and run it again, then this check")
+        assert message == ("name 'C' is not defined: the task cell that makes C is not written "
+                           "yet: replace its line `raise NotImplementedError` with your code, "
+                           "run it, then this check again")
         runner.namespace.update(C=np.eye(2), R=np.eye(2))  # earlier values: not judged
         error = runner.run(check_cell)
         assert str(error) == ("the task cell above is not written yet: replace its line `raise "
                               "NotImplementedError` with your code, run that cell, then this "
                               "check again")
+        assert isinstance(runner.run(task_comment(task) + "C = [[1, 0, 0], [1, 0]\n"), SyntaxError)
+        del runner.namespace["C"]
+        error = runner.run(check_cell)
+        message = task_runs.missing_name_message(error, error.__traceback__)
+        assert message == ("name 'C' is not defined: the task cell that makes C stopped with "
+                           "an error before making it: fix it and run it again, then this check")
         error = runner.run("print(undefined_name)\n")      # not a check cell: IPython's own
         assert task_runs.missing_name_message(error, error.__traceback__) is None
     finally:

@@ -63,5 +63,6 @@ def test_the_worked_cell_passes(cells) -> None:
 def test_a_name_no_cell_made_is_one_line(cells) -> None:
     ename, shown = error_of(cells[7])
     assert ename == "NameError"
-    assert shown == ("NameError: name 'sigma_q' is not defined: the task cell above this check "
-                     "makes it. Write that cell and run it, then this check again")
+    assert shown == ("NameError: name 'sigma_q' is not defined: no cell run so far makes it. "
+                     "Run the cells above this check in order, its task cell too, then this "
+                     "check again")

@@ -244,6 +244,10 @@ def missing_name_message(error: BaseException, tb: types.TracebackType | None) -
     for attribute in ("defines", "mentions"):
         for run in reversed(_RECORD.runs):
             if name in getattr(run, attribute):
+                if run.not_written:
+                    return (f"name '{name}' is not defined: the task cell that makes {name} is "
+                            f"not written yet: replace its line `raise NotImplementedError` "
+                            f"with your code, run it, then this check again")
                 if run.completed:
                     return (f"name '{name}' is not defined: the task cell that makes {name} "
                             f"ran without making it; make {name} there, run that cell, then "
@@ -251,8 +255,8 @@ def missing_name_message(error: BaseException, tb: types.TracebackType | None) -
                 return (f"name '{name}' is not defined: the task cell that makes {name} "
                         f"stopped with an error before making it: fix it and run it again, "
                         f"then this check")
-    return (f"name '{name}' is not defined: the task cell above this check makes it. Write "
-            f"that cell and run it, then this check again")
+    return (f"name '{name}' is not defined: no cell run so far makes it. Run the cells above "
+            f"this check in order, its task cell too, then this check again")
 
 
 def calls_a_check(source: str) -> bool:
