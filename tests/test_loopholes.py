@@ -19,11 +19,13 @@ same frame.
 
 from __future__ import annotations
 
+import ast
 import importlib
 import inspect
 import pkgutil
 import sys
 import types
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -34,18 +36,18 @@ from lqe_helpers.checks import CheckFailed, machinery, own_work
 from lqe_helpers.student_code import calling
 
 #: The worked answers of the function tasks (what the student's function computes after
-#: the pack's call), with arguments of each task's check.
+#: the pack's call), with arguments of each task's check, by the function the task asks for.
 FUNCTION_TASKS = {
-    "check_transition_matrix": (
+    "my_transition_matrix": (
         lambda dt: np.array([[1.0, dt, dt**2 / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]]), (0.01,)),
-    "check_eyes_closed": (lambda P, F, G, sigma: F @ P @ F.T + sigma**2 * G @ G.T,
+    "predict_covariance": (lambda P, F, G, sigma: F @ P @ F.T + sigma**2 * G @ G.T,
                           (np.eye(3), np.eye(3), np.ones((3, 1)), 2.0)),
-    "check_filter": (lambda y, A, C, Q, R, z0, P0: np.zeros((len(y), len(z0))),
+    "my_filter": (lambda y, A, C, Q, R, z0, P0: np.zeros((len(y), len(z0))),
                      (np.zeros((4, 1)), np.eye(2), np.ones((1, 2)), np.eye(2), np.eye(1),
                       np.zeros(2), np.eye(2))),
-    "check_vision_trial": (lambda sigma_v: (np.zeros((4, 1)), np.zeros((4, 3))), (1.5,)),
-    "check_smoother": (lambda y, alpha: np.asarray(y, dtype=float), (np.zeros((1, 4)), 0.5)),
-    "check_compensation": (lambda estimates, A, delay_steps: estimates @ A.T,
+    "vision_trial": (lambda sigma_v: (np.zeros((4, 1)), np.zeros((4, 3))), (1.5,)),
+    "my_smoother": (lambda y, alpha: np.asarray(y, dtype=float), (np.zeros((1, 4)), 0.5)),
+    "compensate": (lambda estimates, A, delay_steps: estimates @ A.T,
                            (np.zeros((4, 2)), np.eye(2), 0)),
 }
 
@@ -138,6 +140,7 @@ def test_no_function_of_the_pack_passes_as_a_function_tasks_answer(task) -> None
     """Every pack function, called at the top and in the middle (behind a bare except) of
     the task's worked answer: the call fails naming it, except the machinery."""
     worked, args = FUNCTION_TASKS[task]
+    allowed = own_work.FUNCTION_TASKS[task]
     machinery_only = []
     for name, function in FUNCTIONS:
         def at_the_top(*given, function=function):
@@ -154,14 +157,30 @@ def test_no_function_of_the_pack_passes_as_a_function_tasks_answer(task) -> None
 
         for student in (at_the_top, in_the_middle):
             try:
-                machinery.call_student(student, *args, name="answer", where="")
+                machinery.call_student(student, *args, name="answer", where="", allow=allowed)
             except CheckFailed as failure:
                 assert f"runs the pack's own {name}" in str(failure), (name, str(failure))
             else:
                 machinery_only.append(name)
     assert set(machinery_only) == {name for name, function in FUNCTIONS
-                                   if calling.machinery(function.__code__)}
-    assert set(machinery_only) <= MACHINERY
+                                   if calling.machinery(function.__code__)
+                                   or function in allowed}
+    assert set(machinery_only) <= MACHINERY | {f"{f.__module__}.{f.__qualname__}" for f in allowed}
+
+
+def test_every_function_task_is_called_with_its_allowlist() -> None:
+    """Each call_student of the checks passes allow=FUNCTION_TASKS[<the task's function>],
+    and every function task of own_work has a check calling it (and is tried above)."""
+    used = set()
+    folder = Path(own_work.__file__).parent
+    for path in sorted(folder.glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text("utf-8"))):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", "") == "call_student":
+                [allow] = [keyword.value for keyword in node.keywords if keyword.arg == "allow"]
+                assert isinstance(allow, ast.Subscript), (path.name, node.lineno)
+                assert getattr(allow.value, "id", "") == "FUNCTION_TASKS", (path.name, node.lineno)
+                used.add(allow.slice.value)
+    assert used == set(own_work.FUNCTION_TASKS) == set(FUNCTION_TASKS)
 
 
 #: The only pack functions a student's function may run: the wrappers around it.

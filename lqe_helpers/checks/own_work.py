@@ -6,9 +6,8 @@ Two kinds of task, two guards:
   ``predict_covariance``, ``my_filter``, ``vision_trial``, ``my_smoother``, ``compensate``):
   every check calls it through :func:`~lqe_helpers.checks.machinery.call_student`, which
   refuses every function of the pack (public or private, any module, at any depth) while the
-  student's function runs (``student_code.call(..., forbid_pack=True)``). The allowlist of
-  each function task is empty today: no task text tells the student to use a pack function
-  inside theirs (a task that did would pass ``allow=`` at its ``call_student``).
+  student's function runs (``student_code.call(..., forbid_pack=True)``) but those of the
+  task's allowlist, :data:`FUNCTION_TASKS` (each call site passes its task's entry).
 - **Top-level tasks** (the student writes code in the task cell): the task-cell record
   (:mod:`lqe_helpers.student_code.task_runs`, registered by ``student_code.brief_errors()``
   in every notebook's set-up cell) notes which of the pack's functions a task cell ran.
@@ -39,6 +38,18 @@ from ..student_code import task_runs
 from .machinery import FUNCTION_RTOL, CheckFailed, close
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
+
+#: Per function task (by the function the student writes): the pack functions its text lets
+#: the student use inside it. Empty for every task today: each asks for the equation written
+#: with NumPy.
+FUNCTION_TASKS: dict[str, tuple[Callable, ...]] = {
+    "my_transition_matrix": (),   # 00 Task 1
+    "predict_covariance": (),     # 00 Task 2 (and Going further's covariance step)
+    "my_filter": (),              # 01 Task 1
+    "vision_trial": (),           # 01 Task 2: calls the student's own (loaded) my_filter
+    "my_smoother": (),            # 01 Going further
+    "compensate": (),             # 05 Task 1
+}
 
 #: The pack's filter engine: eq. (5) and everything built on it (a name ending in "." is
 #: a whole module).
