@@ -356,3 +356,17 @@ def test_every_forbidden_entry_names_a_function_of_the_pack() -> None:
     for check, wanted in own_work.DRIVEN.items():
         assert hasattr(checks, check), check
         assert {item.function for item in wanted} <= {"my_filter", "compensate"}
+
+
+def test_only_the_recent_task_runs_keep_the_calls_of_saved_functions() -> None:
+    runner = CellRunner()
+    try:
+        runner.namespace["note"] = task_runs.note_call
+        for _ in range(task_runs.RUNS_WITH_CALLS + 1):
+            assert runner.run("# Task: one trial\nnote('my_filter', (np.eye(2),), np.eye(2))\n"
+                              .replace("np.eye", "__import__('numpy').eye")) is None
+        runs = task_runs._RECORD.runs
+        assert runs[0].saved_calls == []
+        assert all(len(run.saved_calls) == 1 for run in runs[1:])
+    finally:
+        runner.close()

@@ -35,6 +35,9 @@ TASK_PREFIX = "# Task:"
 
 #: Task runs kept (the most recent last).
 KEPT_RUNS = 200
+#: Of these, the most recent whose calls of the student's saved functions (their inputs and
+#: outputs, copied) are kept; older runs forget them, so memory stays bounded.
+RUNS_WITH_CALLS = 20
 
 
 @dataclass
@@ -184,6 +187,8 @@ class _Record:
                           if not name.startswith(__name__)}
         self.runs.append(run)
         del self.runs[:-KEPT_RUNS]
+        for old in self.runs[:-RUNS_WITH_CALLS]:
+            old.saved_calls.clear()
         return run
 
 
