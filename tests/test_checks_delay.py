@@ -59,7 +59,7 @@ def student_compensate(estimates, A, delay_steps, *, mistake: str = ""):
 
 
 def test_check_compensation_passes_the_worked_solution(capsys) -> None:
-    line = assert_passes(capsys, checks.check_compensation, reference.compensate)
+    line = assert_passes(capsys, checks.check_compensation, student_compensate)
     assert "compensate matches eq. (7)" in line
 
 
@@ -102,7 +102,7 @@ def test_check_compensation_rejects_a_hard_coded_answer() -> None:
 
 def test_check_compensation_rejects_changing_the_estimates_in_place() -> None:
     def compensate(estimates, A, delay_steps):
-        estimates[:] = reference.compensate(estimates, A, delay_steps)
+        estimates[:] = student_compensate(estimates, A, delay_steps)
         return estimates
 
     assert_fails("compensate changed its input estimates in place", checks.check_compensation,
@@ -153,13 +153,13 @@ def test_check_compensation_stops_an_endless_loop(monkeypatch) -> None:
 
 def test_check_compensation_refuses_inf_and_huge_values() -> None:
     def compensate(estimates, A, delay_steps):
-        return reference.compensate(estimates, A, delay_steps) * 1e200
+        return student_compensate(estimates, A, delay_steps) * 1e200
 
     assert_fails("compensate returned values too large to square", checks.check_compensation,
                  compensate)
 
     def with_inf(estimates, A, delay_steps):
-        out = reference.compensate(estimates, A, delay_steps)
+        out = student_compensate(estimates, A, delay_steps)
         out[-1, 0] = np.inf
         return out
 
@@ -421,7 +421,7 @@ def test_check_delay_difference_judges_against_the_engine() -> None:
 
 def test_check_compensation_says_float32_keeps_too_few_digits() -> None:
     def compensate(estimates, A, delay_steps):
-        return reference.compensate(estimates, A, delay_steps).astype(np.float32)
+        return student_compensate(estimates, A, delay_steps).astype(np.float32)
 
     assert_fails("compensate returned float32 numbers, which keep only about 6 digits: compute "
                  "in float64", checks.check_compensation, compensate)

@@ -79,8 +79,8 @@ def student_filter(y, A, C, Q, R, z0, P0, *, mistake: str = ""):
 
 
 def test_check_filter_passes_the_worked_solution(capsys) -> None:
-    line = assert_passes(capsys, checks.check_filter, reference.lqe_filter)
-    assert line == ("✓ lqe_filter matches eq. (5) on 6 random models (1–4 states, 1–3 "
+    line = assert_passes(capsys, checks.check_filter, student_filter)
+    assert line == ("✓ student_filter matches eq. (5) on 6 random models (1–4 states, 1–3 "
                     "sensors, 15 steps) to 1e-9, each call given at most 5 s")
 
 
@@ -269,7 +269,7 @@ def test_check_filter_reports_exit_and_interrupt_as_one_line(stop, phrase) -> No
 
 def test_check_filter_refuses_complex_estimates_even_with_zero_imaginary_part() -> None:
     def my_filter(y, A, C, Q, R, z0, P0):
-        return reference.lqe_filter(y, A, C, Q, R, z0, P0) + 0j
+        return student_filter(y, A, C, Q, R, z0, P0) + 0j
 
     assert_fails("my_filter returned complex numbers (dtype complex128)", checks.check_filter,
                  my_filter)
@@ -283,7 +283,7 @@ def test_check_filter_refuses_a_filter_that_patches_the_engine() -> None:
     original = engine.kalman_filter
 
     def my_filter(y, A, C, Q, R, z0, P0):
-        wrong = reference.lqe_filter(y, A, C, Q, 2.0 * R, z0, P0)
+        wrong = student_filter(y, A, C, Q, 2.0 * R, z0, P0)
 
         def fake(*args, **kwargs):
             return type("Fake", (), {"estimates": wrong, "gains": None})()
@@ -308,6 +308,8 @@ TRUTH = DEFAULT.truth[:, 0]
 NOISE = DEFAULT.unit_noise(sensors=("vision",))
 BURN = DEFAULT.burn_in_steps
 C_VISION = np.array([[1.0, 0.0, 0.0]])
+# The set-up cell's values: a student's vision_trial reads them, it calls no pack function.
+A_SET, Q_SET, P0_SET = DEFAULT.A, DEFAULT.Q, DEFAULT.P0
 
 
 def task2(slip: str = ""):
@@ -328,8 +330,7 @@ def task2(slip: str = ""):
             y = y / 100
         R = np.array([[{"R = sigma": sigma_v, "R = sigma^4": sigma_v**4,
                         "always 1.5": 1.5**2}.get(slip, sigma_v**2)]])
-        estimates = student_filter(y, DEFAULT.A, C_VISION, DEFAULT.Q, R, np.zeros(3),
-                                   DEFAULT.P0)
+        estimates = student_filter(y, A_SET, C_VISION, Q_SET, R, np.zeros(3), P0_SET)
         if slip == "positions only":
             return y, estimates[:, 0]
         if slip == "estimates only":
@@ -367,7 +368,7 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
     ("estimates only", "vision_trial(1.5) must return two things, the readings y and the "
                        "estimates"),
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),
-    ("engine", "vision_trial runs the pack's own lqe_helpers.filter.kalman_filter"),
+    ("engine", "vision_trial runs the pack's own lqe_helpers.experiments.track"),
     ("metres", "vision_trial(1.5) returns (the readings y) is not right: they are in metres"),
 ])
 def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:

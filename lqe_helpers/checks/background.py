@@ -35,6 +35,7 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
+from .own_work import FUNCTION_TASKS
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -96,7 +97,7 @@ def check_transition_matrix(make_A: Callable[[float], np.ndarray], A: object = N
     answers = {}
     for dt in _TRANSITION_DTS:
         output = call_student(make_A, dt, name=name, where=f"dt = {dt:g} s", arg_names=("dt",),
-                              forbid=(model.transition_matrix,))
+                              allow=FUNCTION_TASKS["my_transition_matrix"])
         array = student_result(output, name=name, where=f"dt = {dt:g} s",
                                what="the transition matrix A, an array of shape (3, 3)")
         if array.shape != (3, 3):
@@ -231,7 +232,7 @@ def _judge_covariance_step(predict_covariance: Callable[..., np.ndarray], check:
         where = f"P and F of shape {P.shape}, G of shape {G.shape}, sigma = {sigma:.3g}"
         output = call_student(
             predict_covariance, P, F, G, sigma, name=name, where=where,
-            arg_names=("P", "F", "G", "sigma"), forbid=(propagate_covariance,),
+            arg_names=("P", "F", "G", "sigma"), allow=FUNCTION_TASKS["predict_covariance"],
             shape_hint="P and F are (k, k), G is (k, r): write each term's shape.")
         array = student_result(output, name=name, where=where,
                                what=f"the new covariance P, an array of shape {P.shape}")

@@ -42,13 +42,10 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
+from .own_work import FUNCTION_TASKS
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
-
-#: The pack's own eq. (7), which a student's ``compensate`` may not run (directly, or
-#: through experiments.delay_and_compensate, which calls it).
-_PACKS_EQ7 = (predict_ahead,)
 
 _SHAPE_HINT = (
     "The shapes in one product or assignment do not fit: write the shape beside each "
@@ -133,7 +130,7 @@ def check_compensation(compensate: Callable[..., np.ndarray]) -> None:
 def _run(compensate: Callable, name: str, case: Case) -> np.ndarray:
     output = call_student(compensate, case.estimates, case.A, case.delay, name=name,
                           where=case.describe(), arg_names=COMPENSATE_ARGS,
-                          shape_hint=_SHAPE_HINT, forbid=_PACKS_EQ7)
+                          shape_hint=_SHAPE_HINT, allow=FUNCTION_TASKS["compensate"])
     n, k = case.estimates.shape
     what = f"z*, the compensated estimates, shape (n, k) = {(n, k)}"
     array = student_result(output, name=name, what=what, allow_nan=True, where=case.describe())
@@ -179,7 +176,8 @@ def _check_head(name: str, answer: np.ndarray, case: Case) -> None:
 
 def _check_zero_delay(compensate: Callable, name: str, case: Case) -> None:
     output = call_student(compensate, case.estimates, case.A, 0, name=name,
-                          where=case.describe(), arg_names=COMPENSATE_ARGS, forbid=_PACKS_EQ7,
+                          where=case.describe(), arg_names=COMPENSATE_ARGS,
+                          allow=FUNCTION_TASKS["compensate"],
                           hint=_ZERO_DELAY_HINT)
     array = student_result(output, name=name, what="z*, the compensated estimates",
                            allow_nan=True, where=case.describe())

@@ -100,8 +100,13 @@ def require_callable(function: object, what: str, check: str) -> str:
 
 def call_student(function: Callable, *args: object, name: str, where: str,
                  arg_names: Sequence[str] | None = None, hint: str = "",
-                 shape_hint: str = "", forbid: Sequence[Callable] = ()) -> object:
+                 shape_hint: str = "", forbid: Sequence[Callable] = (),
+                 allow: Sequence[Callable] = ()) -> object:
     """``student_code.call`` for a check: every failure becomes one CheckFailed.
+
+    The student's function may run no function of the pack but those of ``allow`` (a
+    function task writes its answer itself: ``forbid_pack``, see
+    :mod:`lqe_helpers.checks.own_work`).
 
     NotImplementedError becomes :class:`NotWrittenYet` and a time-out :class:`TimedOut`
     (:data:`STOP_CALLING`: a check stops at once, calling again would not help);
@@ -111,7 +116,8 @@ def call_student(function: Callable, *args: object, name: str, where: str,
     """
     try:
         return student_code.call(function, *args, name=name, where=where, arg_names=arg_names,
-                                 hint=hint, shape_hint=shape_hint, forbid=forbid)
+                                 hint=hint, shape_hint=shape_hint, forbid=forbid,
+                                 forbid_pack=True, allow=allow)
     except student_code.NotWrittenYet as error:
         failure: CheckFailed = NotWrittenYet(str(error))
     except student_code.TimedOut as error:

@@ -20,7 +20,6 @@ from collections.abc import Callable
 import numpy as np
 
 from .. import experiments, simulation
-from ..filter import kalman_filter
 from ..scenario import DEFAULT
 from . import filter_models
 from .filter_models import FILTER_ARGS, FILTER_MISTAKES, FILTER_STEPS, FilterCase
@@ -39,6 +38,7 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
+from .own_work import FUNCTION_TASKS
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -83,7 +83,7 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
         models,
         lambda m: call_student(my_filter, *m.args, name=name, where=m.describe(),
                                arg_names=FILTER_ARGS, shape_hint=_FILTER_SHAPE_HINT,
-                               forbid=(kalman_filter,)),
+                               allow=FUNCTION_TASKS["my_filter"]),
         lambda output, m: _filter_output(output, name, m))
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
@@ -306,7 +306,7 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
         right = _trial(sigma)
         output = call_student(vision_trial, sigma, name=name, where=f"σ_v = {sigma:g} cm",
                               arg_names=_TRIAL_ARGS, shape_hint=_TRIAL_SHAPE_HINT,
-                              forbid=(kalman_filter,))
+                              allow=FUNCTION_TASKS["vision_trial"])
         y, estimates = _trial_output(output, name, sigma)
         if np.shape(y) == (n, 3) and np.shape(estimates) == (n, 1):
             raise CheckFailed(f"{name}({sigma:g}) returns the estimates first and the readings "

@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 import ctypes
+import functools
 import inspect
+import os
 import signal
 import sys
 import threading
 import time
 import types
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -81,6 +84,7 @@ def _run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str,
             state["fired"] = True
             raise _TimeIsUp
 
+    machinery_function(on_alarm)
     previous = signal.signal(signal.SIGALRM, on_alarm)
     outer_delay, outer_interval = signal.setitimer(signal.ITIMER_REAL, limit)
     start = time.monotonic()
@@ -144,25 +148,45 @@ class _Tripped(BaseException):
 
 
 class _Watch:
-    """Notices whether a student's function runs any of the ``forbid`` functions.
+    """Notices whether a student's function runs a function of the pack it may not.
 
     A profile hook (``sys.setprofile``, in the thread that runs the student's code) sees
-    every Python function call; entering a forbidden function's code records its name and
-    raises :class:`_Tripped`, which ``except Exception`` cannot swallow. The record stands
-    even if a bare ``except:`` swallows that exception too.
+    every Python function call. Entering a forbidden function's code records its name and
+    raises :class:`_Tripped`, which ``except Exception`` cannot swallow; the record stands
+    even if a bare ``except:`` swallows that exception too. Forbidden are the functions of
+    ``forbid`` and, with ``pack=True``, every function whose code lies in the
+    ``lqe_helpers`` package (public or private, any module, at any depth), except those of
+    ``allow`` (and whatever they call) and the machinery that wraps the student's function
+    (:data:`MACHINERY`: a loaded function's input guard and call record, the time limit's
+    handler, a not-yet-saved function's stand-in).
     """
 
-    def __init__(self, forbid: Sequence[Callable]) -> None:
-        self.codes = {}
-        for function in forbid:
-            code = getattr(inspect.unwrap(function), "__code__", None)
-            if code is None:
-                raise ValueError(f"forbid must hold Python functions, got {function!r}")
-            self.codes[code] = f"{function.__module__}.{function.__qualname__}"
+    def __init__(self, forbid: Sequence[Callable], pack: bool = False,
+                 allow: Sequence[Callable] = ()) -> None:
+        self.codes = {_code_of(function, "forbid"): _qualified(function)
+                      for function in forbid}
+        self.allowed = frozenset(_code_of(function, "allow") for function in allow)
+        self.pack = pack
         self.tripped = ""
 
+    def forbidden(self, frame: types.FrameType) -> str:
+        """The qualified name of ``frame``'s function if the student may not run it, or ""."""
+        code = frame.f_code
+        if code in self.codes:
+            return self.codes[code]
+        if not self.pack or code in self.allowed or not in_pack(code.co_filename):
+            return ""
+        if machinery(code):
+            return ""
+        caller = frame.f_back
+        while caller is not None:  # a function an allowed one calls is allowed
+            if caller.f_code in self.allowed:
+                return ""
+            caller = caller.f_back
+        return pack_name(frame)
+
     def wrap(self, function: Callable) -> Callable:
-        if not self.codes:
+        if not self.codes and not self.pack:
             return function
 
         def watched(*args: object) -> object:
@@ -171,9 +195,11 @@ class _Watch:
             def profile(frame: types.FrameType, event: str, arg: object) -> None:
                 if previous is not None:
                     previous(frame, event, arg)
-                if event == "call" and frame.f_code in self.codes:
-                    self.tripped = self.tripped or self.codes[frame.f_code]
-                    raise _Tripped
+                if event == "call":
+                    name = self.forbidden(frame)
+                    if name:
+                        self.tripped = self.tripped or name
+                        raise _Tripped
 
             sys.setprofile(profile)
             try:
@@ -187,6 +213,59 @@ class _Watch:
         return watched
 
 
+def _code_of(function: Callable, parameter: str) -> types.CodeType:
+    code = getattr(inspect.unwrap(function), "__code__", None)
+    if code is None:
+        raise ValueError(f"{parameter} must hold Python functions, got {function!r}")
+    return code
+
+
+def _qualified(function: Callable) -> str:
+    return f"{function.__module__}.{function.__qualname__}"
+
+
+#: The pack's folder (``lqe_helpers``), with a trailing separator.
+_PACK_FOLDER = os.path.join(os.path.realpath(Path(__file__).resolve().parent.parent), "")
+
+
+@functools.lru_cache(maxsize=4096)
+def in_pack(filename: str) -> bool:
+    """Whether a code object's ``filename`` lies inside the ``lqe_helpers`` package."""
+    return not filename.startswith("<") and os.path.realpath(filename).startswith(_PACK_FOLDER)
+
+
+def pack_name(frame: types.FrameType) -> str:
+    """"lqe_helpers.filter._covariance_sequence" for a frame of the pack's code."""
+    module = frame.f_globals.get("__name__", "lqe_helpers")
+    return f"{module}.{frame.f_code.co_qualname}"
+
+
+#: Code of the pack that runs around a student's function, not as its answer: modules
+#: whose every function is such machinery, and single functions registered by
+#: :func:`machinery_function` (the time limit's signal handler, a stand-in, a recorder).
+MACHINERY_MODULES = ("guards.py",)
+_MACHINERY_CODES: set[types.CodeType] = set()
+
+
+def machinery_function(function: Callable) -> Callable:
+    """Mark ``function`` (of the pack) as machinery a student's function may run through.
+
+    Its own code, not what it wraps (a wrapper's ``__wrapped__`` is the student's function).
+    """
+    _MACHINERY_CODES.add(function.__code__)  # type: ignore[attr-defined]
+    return function
+
+
+def machinery(code: types.CodeType) -> bool:
+    """Whether ``code`` is machinery of :data:`MACHINERY_MODULES` or :func:`machinery_function`."""
+    return code in _MACHINERY_CODES or (
+        os.path.basename(code.co_filename) in MACHINERY_MODULES
+        and os.path.dirname(os.path.realpath(code.co_filename)) == _HERE)
+
+
+_HERE = os.path.dirname(os.path.realpath(__file__))
+
+
 def _copy(value: object) -> object:
     return value.copy() if isinstance(value, np.ndarray) else value
 
@@ -194,7 +273,8 @@ def _copy(value: object) -> object:
 def call(function: Callable, *args: object, name: str | None = None, where: str = "",
          time_limit: float | None = None, arg_names: Sequence[str] | None = None,
          hint: str = "", shape_hint: str = "", rerun: str = "run this check again",
-         forbid: Sequence[Callable] = ()) -> object:
+         forbid: Sequence[Callable] = (), forbid_pack: bool = False,
+         allow: Sequence[Callable] = ()) -> object:
     """Call a student's function on copies of ``args`` under a time limit.
 
     Array arguments are copied, so the student's function cannot change the caller's
@@ -235,6 +315,13 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         Functions of the pack that hold the task's answer (the engine's eq. (5), say).
         If the student's function runs one of them, directly or through anything it
         calls, the call fails: the task is to write it, not to call the pack's.
+    forbid_pack : bool
+        Forbid every function of the pack (any module, public or private, at any depth)
+        but those of ``allow`` and the machinery around the student's function (see
+        :class:`_Watch`). The checks of function tasks call with ``forbid_pack=True``.
+    allow : sequence of callables
+        With ``forbid_pack``: the pack's functions (and what they call) that the task's text
+        lets the student use.
 
     Returns
     -------
@@ -266,7 +353,7 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     before = _snapshot()
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     run = _run_with_alarm if alarm else _run_in_thread
-    watch = _Watch(forbid)
+    watch = _Watch(forbid, pack=forbid_pack, allow=allow)
     kind, value = run(watch.wrap(function), copies, float(time_limit))
     replaced = _restore(before)
     if watch.tripped:

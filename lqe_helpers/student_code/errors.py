@@ -72,15 +72,30 @@ def brief_errors() -> None:
     A ``ValueError`` or ``TypeError`` raised inside ``lqe_helpers`` (it names the input
     and what is allowed, e.g. a NaN passed to ``metrics.mse``) is then shown as the
     student's own frames and that one message, like a failed check, instead of pages of
-    the pack's source; any other error keeps IPython's usual traceback. The notebooks
-    call this in their first code cell; nothing happens outside IPython.
+    the pack's source; any other error keeps IPython's usual traceback. A ``NameError`` in
+    a check cell's own line (``checks.check_x(value)`` with ``value`` never made) is one
+    line saying which task cell makes it. It also starts the task-cell record
+    (:func:`~lqe_helpers.student_code.task_runs.watch_task_cells`), by which each check
+    judges what its current task cell made. The notebooks call this in their first code
+    cell; nothing happens outside IPython.
     """
     shell = _ipython_shell()
     if shell is None:
         return
+    from . import task_runs  # here: task_runs imports calling, which imports this module
+
+    task_runs.watch_task_cells(shell)
 
     def handler(self, etype, value, tb, tb_offset=None):  # IPython's CustomTB signature
-        if _raised_by_the_pack(tb):
+        if issubclass(etype, NameError):
+            message = task_runs.missing_name_message(value, tb)
+            if message is not None:
+                stb = [f"NameError: {message}"]
+                self._showtraceback(etype, value, stb)
+                return stb
+            stb = self.InteractiveTB.structured_traceback(etype, value, tb,
+                                                          tb_offset=tb_offset)
+        elif _raised_by_the_pack(tb):
             stb = self.InteractiveTB.structured_traceback(etype, value, own_frames(tb),
                                                           tb_offset=0)
         else:
@@ -89,7 +104,7 @@ def brief_errors() -> None:
         self._showtraceback(etype, value, stb)
         return stb
 
-    shell.set_custom_exc((ValueError, TypeError), handler)
+    shell.set_custom_exc((ValueError, TypeError, NameError), handler)
 
 
 def _raised_by_the_pack(tb: types.TracebackType | None) -> bool:

@@ -17,9 +17,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .calling import call, function_name
+from .calling import call, function_name, machinery_function
 from .errors import NotSavedYet, StudentCodeError, error_text, short_repr
 from .guards import guarded
+from .task_runs import recorded
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -185,8 +186,9 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     callable
         The function, with the inputs guard of its name if the pack has one
         (:func:`~lqe_helpers.student_code.guards.guarded`: ``my_filter`` given an R that
-        does not fit its readings stops with one line naming R). If its file does not exist
-        yet, a stand-in of the same name that
+        does not fit its readings stops with one line naming R), noting its calls in the
+        task cell that runs it (:func:`~lqe_helpers.student_code.task_runs.recorded`). If
+        its file does not exist yet, a stand-in of the same name that
         raises :class:`NotSavedYet` (one line naming the notebook whose task writes it)
         whenever it is called, so the rest of the notebook (an explorer, say) still runs
         and every use of the function says what to do; :func:`load` then prints that
@@ -220,7 +222,7 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     function = namespace.get(name)
     if not isinstance(function, types.FunctionType):
         raise StudentCodeError(f"{shown} does not define a function {name}")
-    return guarded(name, function)
+    return recorded(name, guarded(name, function))
 
 
 def _not_saved_yet(name: str, message: str) -> Callable:
@@ -230,4 +232,4 @@ def _not_saved_yet(name: str, message: str) -> Callable:
         raise NotSavedYet(message)
 
     stand_in.__name__ = stand_in.__qualname__ = name
-    return stand_in
+    return machinery_function(stand_in)

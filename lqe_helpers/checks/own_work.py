@@ -1,0 +1,221 @@
+"""The student's own work: what each task may not take from the pack, and stale values.
+
+Two kinds of task, two guards:
+
+- **Function tasks** (the student writes a function the check calls: ``my_transition_matrix``,
+  ``predict_covariance``, ``my_filter``, ``vision_trial``, ``my_smoother``, ``compensate``):
+  every check calls it through :func:`~lqe_helpers.checks.machinery.call_student`, which
+  refuses every function of the pack (public or private, any module, at any depth) while the
+  student's function runs (``student_code.call(..., forbid_pack=True)``) but those of the
+  task's allowlist, :data:`FUNCTION_TASKS` (each call site passes its task's entry).
+- **Top-level tasks** (the student writes code in the task cell): the task-cell record
+  (:mod:`lqe_helpers.student_code.task_runs`, registered by ``student_code.brief_errors()``
+  in every notebook's set-up cell) notes which of the pack's functions a task cell ran.
+  :data:`TOP_LEVEL` lists, per check, the pack functions that compute the task's answer
+  (the primitive ones: the record sees calls at any depth, so listing
+  ``model.observation_matrix`` also catches ``experiments.filter_model`` and
+  ``experiments.track``); a check refuses values whose task cell ran one of them.
+  :data:`DRIVEN` lists, per one-trial check of 02–05, the values the student's saved
+  ``my_filter`` (and 05's ``compensate``) must have produced in the task cell: each must
+  equal the output of one of that cell's recorded calls of the loaded function.
+
+:func:`judged` wraps every exported check (``checks/__init__.py``): before the check judges
+anything it finds the check's task cell (:func:`~lqe_helpers.student_code.task_runs.run_for`)
+and refuses when that cell's latest run stopped with an error, ran a forbidden function, or
+did not produce the values with the student's function. Without the record (plain Python,
+pytest, or before the set-up cell) a check behaves as without this module.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..student_code import task_runs
+from .machinery import FUNCTION_RTOL, CheckFailed, close
+
+__tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
+
+#: Per function task (by the function the student writes): the pack functions its text lets
+#: the student use inside it. Empty for every task today: each asks for the equation written
+#: with NumPy.
+FUNCTION_TASKS: dict[str, tuple[Callable, ...]] = {
+    "my_transition_matrix": (),   # 00 Task 1
+    "predict_covariance": (),     # 00 Task 2 (and Going further's covariance step)
+    "my_filter": (),              # 01 Task 1
+    "vision_trial": (),           # 01 Task 2: calls the student's own (loaded) my_filter
+    "my_smoother": (),            # 01 Going further
+    "compensate": (),             # 05 Task 1
+}
+
+#: The pack's filter engine: eq. (5) and everything built on it (a name ending in "." is
+#: a whole module).
+FILTER_ENGINE = ("lqe_helpers.filter.", "lqe_helpers.steady_state.", "lqe_helpers.lowpass.",
+                 "lqe_helpers.bias_model.tracking.")
+
+#: The pack's delay compensation, eq. (7), and its delayed runs.
+COMPENSATION = ("lqe_helpers.prediction.predict_ahead",
+                "lqe_helpers.experiments.delay_and_compensate",
+                "lqe_helpers.experiments.DelayedTracking")
+
+#: Per check of a top-level task: the pack functions that compute its answer. A name is a
+#: function's qualified name (``module.qualname``): it covers the function and whatever is
+#: defined inside it (a class: its methods); a name ending in "." covers a whole module.
+TOP_LEVEL: dict[str, tuple[str, ...]] = {
+    # 00 Task 1: A of eq. (4)
+    "check_transition_matrix": ("lqe_helpers.model.transition_matrix",
+                                "lqe_helpers.bias_model.equations.transition_matrix"),
+    # 00 Task 2: the covariance carried forward, F P Fᵀ + G σ² Gᵀ
+    "check_eyes_closed": ("lqe_helpers.prediction.", "lqe_helpers._matrices.input_noise_covariance",
+                          "lqe_helpers.model.process_noise_covariance"),
+    # 00 Task 3: σ_j of each period
+    "check_jerk_stds": ("lqe_helpers.scenario.matched_jerk_std",),
+    # 02 Task 1, 03 Task 2, 04 Task 2: one trial of the student's my_filter
+    "check_start_of_trial": FILTER_ENGINE,
+    "check_fusion_trial": FILTER_ENGINE,
+    "check_noisier_trial": FILTER_ENGINE,
+    # 03 Task 1: C and R of both senses; 04 Task 1: R
+    "check_fusion": ("lqe_helpers.model.observation_matrix",
+                     "lqe_helpers.model.measurement_noise_covariance",
+                     "lqe_helpers._matrices.observation", "lqe_helpers._matrices.noise_covariance"),
+    "check_noisier_sense": ("lqe_helpers.model.measurement_noise_covariance",
+                            "lqe_helpers._matrices.noise_covariance"),
+    # 05 Task 2: one trial delayed and compensated by the student's my_filter and compensate
+    "check_delay_signals": FILTER_ENGINE + COMPENSATION,
+    # 06 Task 1: F, G and Q of the bias model
+    "check_bias_model": ("lqe_helpers.bias_model.equations.transition_matrix",
+                         "lqe_helpers.bias_model.equations.input_matrix",
+                         "lqe_helpers.bias_model.equations.process_noise_covariance",
+                         "lqe_helpers.bias_model.tracking.",
+                         "lqe_helpers._matrices.input_noise_covariance"),
+}
+
+
+@dataclass(frozen=True)
+class Produced:
+    """A value a check is given that the student's saved function must have produced.
+
+    ``position`` is the argument's index in the check's call. The value must equal one
+    recorded output of ``function`` in the task cell, whole or one column of it (a wrong
+    column is the check's to name), or (``delayed``) such a column shifted by a delay (its
+    leading NaN rows).
+    """
+
+    position: int
+    name: str
+    function: str
+    delayed: bool = False
+
+
+#: Per one-trial check: the values the student's saved functions must have produced in the
+#: task cell (the function's calls recorded by its loaded wrapper).
+DRIVEN: dict[str, tuple[Produced, ...]] = {
+    "check_start_of_trial": (Produced(2, "estimates_small", "my_filter"),
+                             Produced(3, "estimates_large", "my_filter")),
+    "check_fusion_trial": (Produced(0, "vision_positions", "my_filter"),
+                           Produced(1, "fused_positions", "my_filter")),
+    "check_noisier_trial": (Produced(0, "vision_positions", "my_filter"),
+                            Produced(1, "fused_positions", "my_filter")),
+    "check_delay_signals": (Produced(1, "delayed", "my_filter", delayed=True),
+                            Produced(2, "compensated", "compensate")),
+}
+
+RERUN = "fix it and run it again, then this check"
+
+
+def covers(entry: str, name: str) -> bool:
+    """Whether the entry ``entry`` of :data:`TOP_LEVEL` covers the pack function ``name``."""
+    if entry.endswith("."):
+        return name.startswith(entry)
+    return name == entry or name.startswith(f"{entry}.")
+
+
+def forbidden_calls(check: str, run: task_runs.TaskRun) -> list[str]:
+    """The pack functions of ``check``'s forbidden set that the task run ``run`` ran, in the
+    order it first ran them (the outermost first)."""
+    entries = TOP_LEVEL.get(check, ())
+    return list(dict.fromkeys(name for name in run.pack_calls.values()
+                              if any(covers(entry, name) for entry in entries)))
+
+
+def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray]:
+    """What a value made from ``output`` may be: it whole, or one of its columns, (delayed:)
+    shifted ``late`` rows down behind NaN."""
+    found = [output] + [output[..., column] for column in range(output.shape[-1])
+                        if output.ndim >= 2]
+    if delayed:
+        found = [np.concatenate([np.full((late, *part.shape[1:]), np.nan),
+                                 part[: len(part) - late]]) for part in found if part.ndim]
+    return found
+
+
+def _produced_by(value: object, wanted: Produced, run: task_runs.TaskRun) -> bool:
+    try:
+        value = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return True  # not an array of numbers: the check itself says what is wrong with it
+    if value.ndim == 0:
+        return True
+    missing = np.isnan(value).reshape(len(value), -1).all(axis=1)
+    late = int(np.argmin(missing)) if not missing.all() else len(value)
+    for call in run.saved_calls:
+        if call.name != wanted.function:
+            continue
+        try:
+            output = np.asarray(call.output, dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if output.ndim == 0 or len(output) != len(value):
+            continue
+        if any(close(value, candidate, FUNCTION_RTOL)
+               for candidate in _candidates(output, wanted.delayed, late)):
+            return True
+    return False
+
+
+def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
+    """What makes ``check``'s values not the current task cell's own work, or None."""
+    if run.not_written:
+        return ("the task cell above is not written yet: replace its line `raise "
+                "NotImplementedError` with your code, run that cell, then this check again")
+    if not run.completed:
+        return (f"the task cell above stopped with an error: {RERUN} (it judges what that "
+                f"cell makes, not the values of an earlier run)")
+    used = forbidden_calls(check, run)
+    if used:
+        return (f"the task cell above runs the pack's own {used[0]}: the task is to compute "
+                f"this yourself, from the equation, with NumPy, not to call the pack's "
+                f"solution. Change that cell, run it, then this check again")
+    for wanted in DRIVEN.get(check, ()):
+        if wanted.position >= len(args):
+            continue
+        called = any(call.name == wanted.function for call in run.saved_calls)
+        if not called:
+            return (f"the task cell above does not run your {wanted.function}: this task is "
+                    f"done with your own {wanted.function} (loaded from my_functions/). Use it "
+                    f"there, run that cell, then this check again")
+        if not _produced_by(args[wanted.position], wanted, run):
+            return (f"{wanted.name} is not what your {wanted.function} returned in the task "
+                    f"cell above: compute it from your {wanted.function}'s output, run that "
+                    f"cell, then this check again")
+    return None
+
+
+def judged(check: Callable) -> Callable:
+    """``check`` refusing values that are not its current task cell's own work (see above)."""
+    name = check.__name__
+
+    @functools.wraps(check)
+    def judged_check(*args: object, **kwargs: object) -> object:
+        __tracebackhide__ = True
+        run = task_runs.run_for(name)
+        if run is not None:
+            problem = task_problem(name, args, run)
+            if problem is not None:
+                raise CheckFailed(problem)
+        return check(*args, **kwargs)
+
+    return judged_check

@@ -1,0 +1,305 @@
+"""What each task cell of a notebook did when it last ran: completed or not, which of the
+pack's functions it ran, which calls of the student's saved functions it made.
+
+A check must judge what the current task cell produced. In IPython, :func:`watch_task_cells`
+(called by :func:`~lqe_helpers.student_code.brief_errors`, which every notebook's set-up
+cell runs) registers two of IPython's events: ``pre_run_cell`` starts a :class:`TaskRun`
+for a cell whose code starts with a ``# Task:`` comment and sets a profile hook
+(``sys.setprofile``, chained to any hook already set) that notes every function of the
+``lqe_helpers`` package the cell runs, at any depth; ``post_run_cell`` ends it, noting
+whether the cell completed. A function loaded with :func:`~lqe_helpers.student_code.load`
+records its calls (inputs and output) into the task cell running it (:func:`note_call`).
+
+A check finds its task cell with :func:`run_for`: the latest run of a task cell that
+defines (assigns or defs at its top level) one of the names the check cell passes it; else
+of one whose ``# Task:`` comment names one; else the latest task cell run. Outside IPython,
+or before the set-up cell ran, there is no record and :func:`run_for` returns None: the
+checks then behave as without it.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+import sys
+import types
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .calling import in_pack, machinery_function, pack_name
+
+#: How a task cell starts (after blank lines).
+TASK_PREFIX = "# Task:"
+
+#: Task runs kept (the most recent last).
+KEPT_RUNS = 200
+#: Of these, the most recent whose calls of the student's saved functions (their inputs and
+#: outputs, copied) are kept; older runs forget them, so memory stays bounded.
+RUNS_WITH_CALLS = 20
+
+
+@dataclass
+class SavedCall:
+    """One call of a loaded saved function (``my_filter``, ``compensate``) in a task cell."""
+
+    name: str
+    args: tuple
+    output: object
+
+
+@dataclass
+class TaskRun:
+    """One run of a task cell.
+
+    Attributes
+    ----------
+    number : int
+        Its position among the task runs of this kernel (1, 2, …).
+    source : str
+        The cell's code as it ran.
+    defines : frozenset of str
+        Names its top level assigns or defines (from its code, whether or not it ran).
+    mentions : frozenset of str
+        Identifiers its ``# Task:`` comment names.
+    completed : bool or None
+        Whether it ran to its end without an error; None while it runs.
+    not_written : bool
+        Whether it stopped with ``NotImplementedError`` (a student edition's stub).
+    pack_calls : dict
+        Qualified name of each function of the pack it ran, by code object.
+    saved_calls : list of SavedCall
+        Its calls of the student's loaded functions.
+    """
+
+    number: int
+    source: str
+    defines: frozenset[str]
+    mentions: frozenset[str]
+    completed: bool | None = None
+    not_written: bool = False
+    pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
+    saved_calls: list[SavedCall] = field(default_factory=list)
+
+    def ran(self, qualified_names: frozenset[str] | set[str]) -> list[str]:
+        """Which of ``qualified_names`` (``"lqe_helpers.model.observation_matrix"``) it ran."""
+        return sorted(name for name in set(self.pack_calls.values()) if name in qualified_names)
+
+
+def is_task_cell(source: str) -> bool:
+    """Whether a cell's code starts with a ``# Task:`` comment."""
+    return source.lstrip().startswith(TASK_PREFIX)
+
+
+def defined_names(source: str) -> frozenset[str]:
+    """Names assigned or defined at the top level of ``source`` (empty if it does not parse)."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return frozenset()
+    names: set[str] = set()
+    for node in tree.body:
+        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+            names.add(node.name)
+            continue
+        for child in ast.walk(node):
+            if isinstance(child, ast.Name) and isinstance(child.ctx, ast.Store):
+                names.add(child.id)
+    return frozenset(names)
+
+
+def mentioned_names(source: str) -> frozenset[str]:
+    """Identifiers in the comment lines at the top of ``source`` (its ``# Task:`` block)."""
+    words: set[str] = set()
+    for line in source.lstrip().splitlines():
+        if not line.lstrip().startswith("#"):
+            break
+        words.update(re.findall(r"[A-Za-z_][A-Za-z_0-9]*", line))
+    return frozenset(words)
+
+
+def argument_names(source: str, check: str) -> list[str]:
+    """The bare names passed to a call of ``check`` (``checks.check_x(C, R)``) in ``source``."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return []
+    names: list[str] = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call):
+            called = node.func
+            called_name = (called.attr if isinstance(called, ast.Attribute)
+                           else called.id if isinstance(called, ast.Name) else "")
+            if called_name == check:
+                arguments = [*node.args, *(keyword.value for keyword in node.keywords)]
+                names += [argument.id for argument in arguments
+                          if isinstance(argument, ast.Name)]
+    return names
+
+
+class _Record:
+    """The task runs of this kernel and the cell running now."""
+
+    def __init__(self) -> None:
+        self.runs: list[TaskRun] = []
+        self.current: TaskRun | None = None
+        self.cell = ""          # the code of the cell running now
+        self.previous_profile: Callable | None = None
+        self.shells: set[int] = set()
+
+    def pre_run_cell(self, info: object) -> None:
+        source = getattr(info, "raw_cell", "") or ""
+        self.cell = source
+        self._stop()
+        if not is_task_cell(source):
+            return
+        run = TaskRun(number=len(self.runs) + 1, source=source,
+                      defines=defined_names(source), mentions=mentioned_names(source))
+        self.current = run
+        self.previous_profile = previous = sys.getprofile()
+        pack_calls = run.pack_calls
+
+        def noting(frame: types.FrameType, event: str, arg: object) -> None:
+            if previous is not None:
+                previous(frame, event, arg)
+            if event == "call":
+                code = frame.f_code
+                if code not in pack_calls and in_pack(code.co_filename):
+                    pack_calls[code] = pack_name(frame)
+
+        sys.setprofile(noting)
+
+    def post_run_cell(self, result: object) -> None:
+        run = self._stop()
+        if run is not None:
+            run.completed = bool(getattr(result, "success", False))
+            run.not_written = isinstance(getattr(result, "error_in_exec", None),
+                                         NotImplementedError)
+
+    def _stop(self) -> TaskRun | None:
+        run, self.current = self.current, None
+        if run is None:
+            return None
+        sys.setprofile(self.previous_profile)
+        self.previous_profile = None
+        run.pack_calls = {code: name for code, name in run.pack_calls.items()
+                          if not name.startswith(__name__)}
+        self.runs.append(run)
+        del self.runs[:-KEPT_RUNS]
+        for old in self.runs[:-RUNS_WITH_CALLS]:
+            old.saved_calls.clear()
+        return run
+
+
+_RECORD = _Record()
+
+
+def watch_task_cells(shell: object) -> None:
+    """Register the task-cell record with an IPython ``shell`` (once per shell).
+
+    ``shell.events`` must offer ``register(name, callback)`` for ``pre_run_cell`` and
+    ``post_run_cell`` (IPython's ``EventManager``).
+    """
+    if id(shell) in _RECORD.shells:
+        return
+    shell.events.register("pre_run_cell", _RECORD.pre_run_cell)
+    shell.events.register("post_run_cell", _RECORD.post_run_cell)
+    _RECORD.shells.add(id(shell))
+
+
+def watching() -> bool:
+    """Whether task cells are being recorded (a set-up cell registered the events)."""
+    return bool(_RECORD.shells)
+
+
+def current_cell() -> str:
+    """The code of the cell running now ("" without the record)."""
+    return _RECORD.cell
+
+
+def run_for(check: str) -> TaskRun | None:
+    """The task run that the check ``check`` (its function's name) called now judges.
+
+    None without the record (plain Python, pytest) or before any task cell ran.
+    """
+    if not watching() or not _RECORD.runs:
+        return None
+    names = set(argument_names(_RECORD.cell, check))
+    for attribute in ("defines", "mentions"):
+        for run in reversed(_RECORD.runs):
+            if names & getattr(run, attribute):
+                return run
+    return _RECORD.runs[-1]
+
+
+def missing_name_message(error: BaseException, tb: types.TracebackType | None) -> str | None:
+    """One line for a ``NameError`` raised in a check cell's own line, or None.
+
+    None unless the cell running now calls a ``check_…`` function and the error was raised
+    at the cell's top level (not inside a function it calls).
+    """
+    last = tb
+    while last is not None and last.tb_next is not None:
+        last = last.tb_next
+    name = getattr(error, "name", None)
+    if (last is None or last.tb_frame.f_code.co_name != "<module>" or not name
+            or not calls_a_check(_RECORD.cell)):
+        return None
+    for attribute in ("defines", "mentions"):
+        for run in reversed(_RECORD.runs):
+            if name in getattr(run, attribute):
+                if run.not_written:
+                    return (f"name '{name}' is not defined: the task cell that makes {name} is "
+                            f"not written yet: replace its line `raise NotImplementedError` "
+                            f"with your code, run it, then this check again")
+                if run.completed:
+                    return (f"name '{name}' is not defined: the task cell that makes {name} "
+                            f"ran without making it; make {name} there, run that cell, then "
+                            f"this check again")
+                return (f"name '{name}' is not defined: the task cell that makes {name} "
+                        f"stopped with an error before making it: fix it and run it again, "
+                        f"then this check")
+    return (f"name '{name}' is not defined: no cell run so far makes it. Run the cells above "
+            f"this check in order, its task cell too, then this check again")
+
+
+def calls_a_check(source: str) -> bool:
+    """Whether ``source`` calls a function named ``check_…``."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return False
+    return any(isinstance(node, ast.Call) and (
+        getattr(node.func, "attr", "") or getattr(node.func, "id", "")).startswith("check_")
+        for node in ast.walk(tree))
+
+
+@machinery_function
+def note_call(name: str, args: tuple, output: object) -> None:
+    """Record a call of the loaded function ``name`` in the task cell running now, if any."""
+    run = _RECORD.current
+    if run is not None:
+        copies = tuple(arg.copy() if isinstance(arg, np.ndarray) else arg for arg in args)
+        kept = output.copy() if isinstance(output, np.ndarray) else output
+        run.saved_calls.append(SavedCall(name, copies, kept))
+
+
+def recorded(name: str, function: Callable) -> Callable:
+    """``function`` (a loaded saved function) noting each of its calls with :func:`note_call`."""
+
+    def recording(*args: object, **kwargs: object) -> object:
+        output = function(*args, **kwargs)
+        note_call(name, args + tuple(kwargs.values()), output)
+        return output
+
+    recording.__name__ = recording.__qualname__ = getattr(function, "__name__", name)
+    recording.__doc__ = getattr(function, "__doc__", None)
+    recording.__wrapped__ = function  # type: ignore[attr-defined]
+    return machinery_function(recording)
+
+
+def _reset() -> None:
+    """Forget every run and registered shell (tests)."""
+    _RECORD._stop()
+    _RECORD.__init__()

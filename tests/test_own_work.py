@@ -1,0 +1,372 @@
+"""Issue 23 §1 and §3: no pack answer passes for the student's, and a ✓ only on what the
+current task cell made.
+
+Each case runs a notebook's own cells up to a task (``cell_runner``: IPython's cell events
+fired at a fake shell, no kernel), then a task cell with the loophole, then the notebook's
+check cell. Where the loophole gives the right values, the same cells without the record
+(as in plain Python, and as every check behaved before) pass: the refusal is what stops it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import inspect
+import io
+
+import numpy as np
+import pytest
+from cell_runner import CellRunner, cells_up_to, saved_functions, task_comment
+from check_outcomes import assert_fails
+from test_checks_background import eyes_closed
+
+from lqe_helpers import bias_model, checks, filter, prediction
+from lqe_helpers.checks import CheckFailed, own_work
+from lqe_helpers.student_code import task_runs
+
+
+@pytest.fixture
+def folder(tmp_path, monkeypatch):
+    """A notebook folder holding the worked notebooks' saved functions, as the working folder."""
+    saved_functions(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+def run_task(notebook: str, check: str, code: str | None, *,
+             watch: bool = True) -> tuple[BaseException | None, str]:
+    """The notebook's cells before ``check``'s task, the task cell (its comment, then
+    ``code``; None: the worked code), then the check cell. Returns the check cell's error
+    and what it printed."""
+    before, task, check_cell = cells_up_to(notebook, check)
+    runner = CellRunner(watch=watch)
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            for source in before:
+                error = runner.run(source)
+                assert error is None, (source[:200], error)
+            error = runner.run(task if code is None else task_comment(task) + code)
+        assert error is None, error
+        with contextlib.redirect_stdout(io.StringIO()) as printed:
+            error = runner.run(check_cell)
+        return error, printed.getvalue()
+    finally:
+        runner.close()
+
+
+# ------------------------------------------------------------------------------------------
+# §1, top-level and one-trial tasks: the pack's answer computed in the task cell
+# ------------------------------------------------------------------------------------------
+
+LOOPHOLES = {
+    "00 Task 1, A from the pack": (
+        "00_background_model", "check_transition_matrix",
+        "def my_transition_matrix(dt):\n"
+        "    return np.array([[1.0, dt, dt**2 / 2], [0.0, 1.0, dt], [0.0, 0.0, 1.0]])\n"
+        "A = model.transition_matrix(DEFAULT.dt)\n",
+        "lqe_helpers.model.transition_matrix"),
+    "00 Task 2, the band from propagate_covariance": (
+        "00_background_model", "check_eyes_closed",
+        "def predict_covariance(P, F, G, sigma):\n"
+        "    return F @ P @ F.T + sigma**2 * G @ G.T\n"
+        "Q_step = sigma_j**2 * g @ g.T\n"
+        "two_sigma = 2 * np.sqrt(propagate_covariance(P_close, A, Q_step, 100)[:, 0, 0])\n",
+        "lqe_helpers.prediction.propagate_covariance"),
+    "00 Task 3, scenario.matched_jerk_std": (
+        "00_background_model", "check_jerk_stds",
+        "from lqe_helpers import scenario\n"
+        "jerk_stds = {name: scenario.matched_jerk_std(DEFAULT.amplitude, DEFAULT.frequency,\n"
+        "                                             DEFAULT.dt, fraction)\n"
+        "             for name, fraction in periods.items()}\n",
+        "lqe_helpers.scenario.matched_jerk_std"),
+    "02 Task 1, estimates from the engine without my_filter": (
+        "02_initial_covariance", "check_start_of_trial",
+        "import dataclasses\n"
+        "P0_small = np.diag([1.0, 1.0, 1.0])\n"
+        "P0_large = np.diag([1e5, 1e5, 1e5])\n"
+        "large = dataclasses.replace(DEFAULT, p0_variance=1e5)\n"
+        "estimates_small = experiments.track(DEFAULT).result.estimates\n"
+        "estimates_large = experiments.track(large).result.estimates\n",
+        "lqe_helpers.filter.kalman_filter"),
+    "03 Task 1, C and R from the model": (
+        "03_fusion", "check_fusion",
+        "from lqe_helpers import model\n"
+        "C = model.observation_matrix(FUSED)\n"
+        "R = model.measurement_noise_covariance([sigma_v, sigma_p])\n",
+        "lqe_helpers.model.observation_matrix"),
+    "03 Task 2, the positions of experiments.track": (
+        "03_fusion", "check_fusion_trial",
+        "fused_positions = experiments.track(DEFAULT, FUSED).positions\n"
+        "vision_positions = experiments.track(DEFAULT, ('vision',)).positions\n"
+        "mse_fused_trial = float(metrics.mse(fused_positions, truth, burn_in))\n"
+        "mse_vision_trial = float(metrics.mse(vision_positions, truth, burn_in))\n",
+        "lqe_helpers.filter.kalman_filter"),
+    "04 Task 1, R from the model": (
+        "04_noisier_proprioception", "check_noisier_sense",
+        "from lqe_helpers import model\n"
+        "sigma_p = 4.5\n"
+        "R = model.measurement_noise_covariance([sigma_v, sigma_p])\n",
+        "lqe_helpers.model.measurement_noise_covariance"),
+    "05 Task 2, the fields of experiments.delay_and_compensate": (
+        "05_sensory_delay", "check_delay_signals",
+        "shifted = experiments.delay_and_compensate(experiments.track(DEFAULT), delay)\n"
+        "late_readings = shifted.delayed_measurements[:, 0]\n"
+        "delayed = shifted.delayed_estimates[:, 0]\n"
+        "compensated = shifted.predictions[:, 0]\n",
+        "lqe_helpers.filter.kalman_filter"),
+    "06 Task 1, the bias model's matrices": (
+        "06_bonus_bias_and_input", "check_bias_model",
+        "F = bias_model.transition_matrix(dt)\n"
+        "G = bias_model.input_matrix(dt)\n"
+        "Q = bias_model.process_noise_covariance(dt, sigma_a)\n",
+        "lqe_helpers.bias_model.equations.transition_matrix"),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", list(LOOPHOLES))
+def test_a_task_cell_that_computes_with_the_packs_answer_fails_its_check(case, folder) -> None:
+    notebook, check, code, named = LOOPHOLES[case]
+    error, printed = run_task(notebook, check, code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)  # right values
+    error, printed = run_task(notebook, check, code)
+    assert isinstance(error, CheckFailed), error
+    assert f"the task cell above runs the pack's own {named}" in str(error), str(error)
+    assert printed == ""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("notebook", "check"), [
+    ("00_background_model", "check_jerk_stds"), ("02_initial_covariance", "check_start_of_trial"),
+    ("03_fusion", "check_fusion_trial"), ("05_sensory_delay", "check_delay_signals"),
+    ("06_bonus_bias_and_input", "check_bias_model")])
+def test_the_worked_task_cell_passes_with_the_record(notebook, check, folder) -> None:
+    error, printed = run_task(notebook, check, None)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+@pytest.mark.slow
+def test_a_one_trial_task_computed_by_hand_without_my_filter_fails(folder) -> None:
+    """02 Task 1 with eq. (5) retyped in the cell: right values, but not the saved my_filter."""
+    code = ("def loop(P):\n"
+            "    z, estimates = z0, []\n"
+            "    for y_j in y:\n"
+            "        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)\n"
+            "        z = A @ z + K @ (y_j - C @ A @ z)\n"
+            "        P = A @ (P - K @ C @ P) @ A.T + Q\n"
+            "        estimates.append(z)\n"
+            "    return np.array(estimates)\n"
+            "P0_small = np.diag([1.0, 1.0, 1.0])\n"
+            "P0_large = np.diag([1e5, 1e5, 1e5])\n"
+            "estimates_small, estimates_large = loop(P0_small), loop(P0_large)\n")
+    error, printed = run_task("02_initial_covariance", "check_start_of_trial", code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, _ = run_task("02_initial_covariance", "check_start_of_trial", code)
+    assert "the task cell above does not run your my_filter" in str(error), error
+
+
+HAND_LOOP = ("def loop(y, C, R):\n"
+             "    z, P, estimates = z0, P0, []\n"
+             "    for y_j in y:\n"
+             "        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)\n"
+             "        z = A @ z + K @ (y_j - C @ A @ z)\n"
+             "        P = A @ (P - K @ C @ P) @ A.T + Q\n"
+             "        estimates.append(z)\n"
+             "    return np.array(estimates)\n")
+
+
+@pytest.mark.slow
+def test_a_one_trial_value_not_from_my_filter_fails(folder) -> None:
+    """03 Task 2: my_filter runs, but the fused positions come from another loop."""
+    code = (HAND_LOOP
+            + "fused_positions = loop(y, C, R)[:, 0]\n"
+            "vision_positions = my_filter(y[:, :1], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]\n"
+            "mse_fused_trial = float(metrics.mse(fused_positions, truth, burn_in))\n"
+            "mse_vision_trial = float(metrics.mse(vision_positions, truth, burn_in))\n")
+    error, printed = run_task("03_fusion", "check_fusion_trial", code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, _ = run_task("03_fusion", "check_fusion_trial", code)
+    assert "fused_positions is not what your my_filter returned in the task cell above" in str(
+        error), error
+
+
+@pytest.mark.slow
+def test_a_slip_with_my_filters_output_still_gets_its_named_cause(folder) -> None:
+    """The velocity column of my_filter's estimates came from my_filter: the check names it."""
+    code = ("fused_positions = my_filter(y, A, C, Q, R, z0, P0)[:, 1]\n"
+            "vision_positions = my_filter(y[:, :1], A, C[:1], Q, R[:1, :1], z0, P0)[:, 0]\n"
+            "mse_fused_trial = float(metrics.mse(fused_positions, truth, burn_in))\n"
+            "mse_vision_trial = float(metrics.mse(vision_positions, truth, burn_in))\n")
+    error, _ = run_task("03_fusion", "check_fusion_trial", code)
+    assert "fused_positions is not right: it is column 1 of the estimates, the velocity" in str(
+        error), error
+
+
+# ------------------------------------------------------------------------------------------
+# §1, function tasks: any function of the pack, at any depth
+# ------------------------------------------------------------------------------------------
+
+def bias_matrix_abs(dt):
+    return np.abs(bias_model.transition_matrix(dt))
+
+
+def predict_with_private_propagate(P, F, G, sigma):
+    return prediction._propagate(P, F, sigma**2 * G @ G.T, 1, "steps")[-1]
+
+
+def loop_over_the_packs_gains(y, A, C, Q, R, z0, P0):
+    gains = filter._covariance_sequence(len(y), A, C, Q, R, P0).gains
+    z, estimates = z0, []
+    for y_j, K in zip(y, gains, strict=True):
+        z = A @ z + K @ (y_j - C @ A @ z)
+        estimates.append(z)
+    return np.array(estimates)
+
+
+def compensate_with_delay_signal(estimates, A, delay_steps):
+    from lqe_helpers.simulation import delay_signal
+
+    return delay_signal(estimates, delay_steps) @ np.linalg.matrix_power(A, delay_steps).T
+
+
+@pytest.mark.parametrize(("check", "function", "named"), [
+    (checks.check_transition_matrix, bias_matrix_abs,
+     "lqe_helpers.bias_model.equations.transition_matrix"),
+    (checks.check_eyes_closed, predict_with_private_propagate, "lqe_helpers.prediction._propagate"),
+    (checks.check_filter, loop_over_the_packs_gains, "lqe_helpers.filter._covariance_sequence"),
+    (checks.check_compensation, compensate_with_delay_signal,
+     "lqe_helpers.simulation.delay_signal"),
+])
+def test_a_function_task_that_runs_any_function_of_the_pack_fails(check, function, named):
+    """The issue's cases, each the right answer: an old per-check forbid list missed them."""
+    given = (eyes_closed()[0],) if check is checks.check_eyes_closed else ()
+    assert_fails(f"runs the pack's own {named}", check, function, *given)
+
+
+def test_a_function_task_may_call_the_students_own_loaded_function(folder, capsys) -> None:
+    """01 Task 2 calls the saved my_filter: its wrappers (guard, call record) are no answer."""
+    from lqe_helpers import student_code
+
+    error, printed = run_task("01_vision_only", "check_vision_trial", None)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    loaded = student_code.load("my_filter")
+    assert inspect.unwrap(loaded).__module__ == "my_functions.my_filter"
+
+
+# ------------------------------------------------------------------------------------------
+# §3: a ✓ only on what the current task cell made
+# ------------------------------------------------------------------------------------------
+
+def test_a_check_after_a_failed_task_cell_does_not_judge_the_old_values(folder, capsys):
+    """03 Task 1 ran right, then failed when run again: C and R are the earlier run's."""
+    before, task, check_cell = cells_up_to("03_fusion", "check_fusion")
+    runner = CellRunner()
+    try:
+        for source in before:
+            assert runner.run(source) is None
+        assert runner.run(task) is None
+        assert runner.run(check_cell) is None
+        assert capsys.readouterr().out.startswith("✓ ")
+        broken = task_comment(task) + "C = np.array([[1.0, 0.0, 0.0], [1.0, 0.0]])\nR = C\n"
+        assert isinstance(runner.run(broken), ValueError)
+        error = runner.run(check_cell)
+        assert "the task cell above stopped with an error: fix it and run it again" in str(error)
+        assert "✓" not in capsys.readouterr().out
+        assert runner.run(task) is None and runner.run(check_cell) is None  # fixed: ✓ again
+        assert capsys.readouterr().out.startswith("✓ ")
+    finally:
+        runner.close()
+
+
+def test_a_name_the_check_cell_passes_that_no_cell_made_is_one_line(folder):
+    before, task, check_cell = cells_up_to("03_fusion", "check_fusion")
+    runner = CellRunner()
+    try:
+        for source in before:
+            assert runner.run(source) is None
+        error = runner.run(check_cell)                      # the task cell never ran
+        assert isinstance(error, NameError)
+        message = task_runs.missing_name_message(error, error.__traceback__)
+        assert message == ("name 'C' is not defined: no cell run so far makes it. Run the "
+                           "cells above this check in order, its task cell too, then this check "
+                           "again")
+        stub = task_comment(task) + "raise NotImplementedError\n"
+        assert isinstance(runner.run(stub), NotImplementedError)
+        error = runner.run(check_cell)
+        message = task_runs.missing_name_message(error, error.__traceback__)
+        assert message == ("name 'C' is not defined: the task cell that makes C is not written "
+                           "yet: replace its line `raise NotImplementedError` with your code, "
+                           "run it, then this check again")
+        runner.namespace.update(C=np.eye(2), R=np.eye(2))  # earlier values: not judged
+        error = runner.run(check_cell)
+        assert str(error) == ("the task cell above is not written yet: replace its line `raise "
+                              "NotImplementedError` with your code, run that cell, then this "
+                              "check again")
+        assert isinstance(runner.run(task_comment(task) + "C = [[1, 0, 0], [1, 0]\n"), SyntaxError)
+        del runner.namespace["C"]
+        error = runner.run(check_cell)
+        message = task_runs.missing_name_message(error, error.__traceback__)
+        assert message == ("name 'C' is not defined: the task cell that makes C stopped with "
+                           "an error before making it: fix it and run it again, then this check")
+        error = runner.run("print(undefined_name)\n")      # not a check cell: IPython's own
+        assert task_runs.missing_name_message(error, error.__traceback__) is None
+    finally:
+        runner.close()
+
+
+def test_without_the_record_a_check_judges_the_values_as_before(folder, capsys):
+    """Plain Python (no IPython events): the check judges the values it is given."""
+    before, task, check_cell = cells_up_to("03_fusion", "check_fusion")
+    runner = CellRunner(watch=False)
+    try:
+        for source in [*before, task]:
+            assert runner.run(source) is None
+        assert isinstance(runner.run(task_comment(task) + "raise ValueError\n"), ValueError)
+        assert task_runs.run_for("check_fusion") is None
+        assert runner.run(check_cell) is None
+        assert capsys.readouterr().out.startswith("✓ ")
+    finally:
+        runner.close()
+
+
+def test_the_task_cell_of_a_check_is_the_latest_that_makes_its_names() -> None:
+    task_runs._reset()
+    runner = CellRunner()
+    try:
+        runner.run("# Task: build C\nC = 1\n")
+        runner.run("# Task: build D from C\nD = C + 1\nraise ValueError\n")
+        runner.run("checks = None\n")
+        task_runs._RECORD.cell = "checks.check_fusion(C, R)"
+        run = task_runs.run_for("check_fusion")
+        assert run is not None and run.defines == {"C"} and run.completed
+        task_runs._RECORD.cell = "checks.check_other(D)"
+        assert task_runs.run_for("check_other").completed is False
+    finally:
+        runner.close()
+
+
+def test_every_forbidden_entry_names_a_function_of_the_pack() -> None:
+    """A misspelt entry would forbid nothing, silently."""
+    from test_loopholes import pack_functions
+
+    names = [name for name, _ in pack_functions()]
+    for check, entries in own_work.TOP_LEVEL.items():
+        assert hasattr(checks, check), check
+        for entry in entries:
+            assert any(own_work.covers(entry, name) for name in names), (check, entry)
+    for check, wanted in own_work.DRIVEN.items():
+        assert hasattr(checks, check), check
+        assert {item.function for item in wanted} <= {"my_filter", "compensate"}
+
+
+def test_only_the_recent_task_runs_keep_the_calls_of_saved_functions() -> None:
+    runner = CellRunner()
+    try:
+        runner.namespace["note"] = task_runs.note_call
+        for _ in range(task_runs.RUNS_WITH_CALLS + 1):
+            assert runner.run("# Task: one trial\nnote('my_filter', (np.eye(2),), np.eye(2))\n"
+                              .replace("np.eye", "__import__('numpy').eye")) is None
+        runs = task_runs._RECORD.runs
+        assert runs[0].saved_calls == []
+        assert all(len(run.saved_calls) == 1 for run in runs[1:])
+    finally:
+        runner.close()
