@@ -9,7 +9,7 @@ from pathlib import Path
 
 import nbformat
 import pytest
-from grading_submissions import NAME, WORKED, edition, endless_loop, raises_first
+from grading_submissions import NAME, WORKED, WRONG_FILTER, edition, endless_loop, raises_first
 
 from lqe_helpers.authoring import grade, grading, nbgrader_course
 from lqe_helpers.authoring.marking_guide import QUESTION_MARKS, question_and_marks
@@ -206,3 +206,13 @@ def test_grade_tool_stops_a_notebook_past_its_limit_with_its_kernel(tmp_path: Pa
     assert not left, left
     assert sorted(p.name for p in (tmp_path / "out" / "results" / "dave").iterdir()) == [
         f"{NAME}.json"]
+
+
+def test_graded_copy_keeps_a_task_that_calls_its_check() -> None:
+    """A student who calls the check in their own task cell keeps their code."""
+    notebook = edition()
+    task = next(c for c in notebook.cells if "def my_filter" in c.source)
+    task.source = WRONG_FILTER + "\nchecks.check_filter(my_filter)\n"
+    task.id = "the-students-own"
+    run, _ = grade.graded_copy(notebook, nbformat.read(WORKED, as_version=4), 15)
+    assert any(cell.source == task.source for cell in run.cells)

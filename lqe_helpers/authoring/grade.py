@@ -50,7 +50,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.grading import core_end, graded_cells
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
-    from lqe_helpers.authoring.task_cells import EXPLORER_TAG, cell_tags
+    from lqe_helpers.authoring.task_cells import EXPLORER_TAG, SOLUTION_TAG, TASK_TAG, cell_tags
 
 CELL_TIMEOUT, NOTEBOOK_TIMEOUT = 60.0, 600.0
 PASSED = "passed"
@@ -69,7 +69,8 @@ def graded_copy(submission: nbformat.NotebookNode, worked: nbformat.NotebookNode
     cells, found = [], set()
     for cell in submission.cells[:core_end(submission)]:
         source = by_id.get(cell.get("id"))
-        if source is None:
+        if source is None and cell.get("id") not in tasks \
+                and not {TASK_TAG, SOLUTION_TAG} & set(cell_tags(cell)):
             source = next((worked_cell for text, grade_id in checks.items()
                            if f"checks.{grade_id}(" in cell.source
                            for worked_cell in worked.cells if worked_cell.source == text), None)
@@ -129,9 +130,8 @@ def grade_one(path: Path, worked_path: Path, cell_timeout: float, result_path: P
             result["error"] = error_line(error)
         finally:
             pid_file.unlink(missing_ok=True)
-    plan = {g.grade_id for g in graded_cells(worked, marks) if g.kind == "check"}
     for cell in run.cells:
-        grade_id = next((gid for gid in plan if f"checks.{gid}(" in cell.source), None)
+        grade_id = next((gid for gid in points if f"checks.{gid}(" in cell.source), None)
         if grade_id and cell.get("execution_count") is not None:
             result["checks"][grade_id] = cause(cell)
     result["points"] = sum(points[g] for g, outcome in result["checks"].items()
@@ -147,8 +147,7 @@ def submissions(folder: Path, source_dir: Path) -> list[tuple[str, str, Path | N
         if not student.is_dir() or student.is_symlink():
             found.append((student.name, "", student, None))
             continue
-        files = sorted(p for p in student.iterdir() if p.suffix == ".ipynb" or p.is_file())
-        notebooks = [p for p in files if p.suffix == ".ipynb"]
+        notebooks = sorted(p for p in student.iterdir() if p.suffix == ".ipynb")
         found += [(student.name, p.name, p, worked.get(p.name) or next(
             (w for name, w in worked.items() if name[:2] == p.name[:2]), None))
                   for p in notebooks]
@@ -174,7 +173,7 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
         result_path = out / "results" / student / f"{name or 'no-notebook'}.json"
         digest = hashlib.sha256(path.read_bytes()).hexdigest() if path and path.is_file() else ""
         rows.append((student, name, result_path, worked))
-        if result_path.is_file() and json.loads(result_path.read_text()).get("sha256") == digest:
+        if _saved_digest(result_path) == digest:
             skipped += 1
             continue
         if path is None or worked is None or not path.is_file():
@@ -189,6 +188,14 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
     graded = len(todo)
     _run_workers(todo, jobs, cell_timeout, notebook_timeout)
     return _write_reports(rows, out), graded, skipped
+
+
+def _saved_digest(path: Path) -> str | None:
+    """The submission digest a saved result records (None: no usable result)."""
+    try:
+        return json.loads(path.read_text(encoding="utf-8")).get("sha256")
+    except (OSError, ValueError, AttributeError):
+        return None
 
 
 def _save(path: Path, result: dict) -> None:
