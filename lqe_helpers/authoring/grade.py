@@ -54,19 +54,29 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
 CELL_TIMEOUT, NOTEBOOK_TIMEOUT = 60.0, 600.0
 PASSED = "passed"
+#: Run first in every grading kernel: figures are built as the notebook asks, but not
+#: rendered to PNG (they carry no points; rendering is a third of 01's run).
+PRELUDE = """\
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as _plt
+import lqe_helpers.plotting as _plotting
+_plotting.show_figure = (lambda close: lambda figure, description: close(figure))(_plt.close)
+del matplotlib, _plt, _plotting"""
 
 
 def graded_copy(submission: nbformat.NotebookNode, worked: nbformat.NotebookNode,
                 marks: int) -> tuple[nbformat.NotebookNode, set[str]]:
     """The notebook to run: the submission's core path, every worked cell but the tasks
     restored (matched by cell id, a check cell else by the check it calls), explorers left
-    out. Returns it and the grade ids of checks missing from the submission."""
+    out, :data:`PRELUDE` first. Returns it and the grade ids of checks missing from the
+    submission."""
     plan = graded_cells(worked, marks)
     tasks = {worked.cells[g.index].get("id") for g in plan if g.kind == "task"}
     checks = {worked.cells[g.index].source: g.grade_id for g in plan if g.kind == "check"}
     by_id = {cell.get("id"): cell for cell in worked.cells[:core_end(worked)]
              if cell.get("id") not in tasks}
-    cells, found = [], set()
+    cells, found = [nbformat.v4.new_code_cell(PRELUDE)], set()
     for cell in submission.cells[:core_end(submission)]:
         source = by_id.get(cell.get("id"))
         if source is None and cell.get("id") not in tasks \
