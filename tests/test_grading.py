@@ -216,3 +216,18 @@ def test_graded_copy_keeps_a_task_that_calls_its_check() -> None:
     task.id = "the-students-own"
     run, _ = grade.graded_copy(notebook, nbformat.read(WORKED, as_version=4), 15)
     assert any(cell.source == task.source for cell in run.cells)
+
+
+@pytest.mark.slow
+def test_grade_tool_gives_a_huge_submission_its_row(tmp_path: Path) -> None:
+    """A 300 MB file (sparse: no disk used) is refused by size, with its row."""
+    subs = tmp_path / "subs"
+    (subs / "erin").mkdir(parents=True)
+    with (subs / "erin" / NAME).open("wb") as file:
+        file.truncate(300 * 2**20)
+    table, graded, _ = grade.grade_all(subs, tmp_path / "out", WORKED.parent, jobs=1,
+                                       cell_timeout=10, notebook_timeout=60)
+    row = table.read_text(encoding="utf-8").splitlines()[1]
+    assert graded == 1
+    assert row.startswith("erin,01_vision_only.ipynb,0,9,\"not graded: ")
+    assert "is 300 MB, larger than the 256 MB the tools read as a notebook" in row

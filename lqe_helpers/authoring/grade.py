@@ -181,7 +181,7 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
     rows, todo, skipped = [], [], 0
     for student, name, path, worked in submissions(folder, source_dir):
         result_path = out / "results" / student / f"{name or 'no-notebook'}.json"
-        digest = hashlib.sha256(path.read_bytes()).hexdigest() if path and path.is_file() else ""
+        digest = _digest(path) if path and path.is_file() else ""
         rows.append((student, name, result_path, worked))
         if _saved_digest(result_path) == digest:
             skipped += 1
@@ -198,6 +198,15 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
     graded = len(todo)
     _run_workers(todo, jobs, cell_timeout, notebook_timeout)
     return _write_reports(rows, out), graded, skipped
+
+
+def _digest(path: Path) -> str:
+    """SHA-256 of a file, read in blocks (a submission may be huge)."""
+    digest = hashlib.sha256()
+    with path.open("rb") as file:
+        while block := file.read(1 << 20):
+            digest.update(block)
+    return digest.hexdigest()
 
 
 def _saved_digest(path: Path) -> str | None:
