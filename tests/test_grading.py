@@ -168,9 +168,10 @@ def test_grade_tool_gives_every_odd_submission_a_row(tmp_path: Path) -> None:
                                              cell_timeout=10, notebook_timeout=10)
     text = table.read_text(encoding="utf-8")
     assert (graded, skipped) == (0, 0)
-    assert "carol,99_mine.ipynb,0,0,not graded: no notebook of the course has this name" in text
-    assert "nobody,,0,0,not graded: no notebook submitted" in text
-    assert "loose.ipynb,,0,0,not graded: not in a student's folder" in text
+    assert "carol,99_mine.ipynb,,0,0,not graded: no notebook of the course has this name" \
+        in text
+    assert "nobody,,,0,0,not graded: no notebook submitted" in text
+    assert "loose.ipynb,,,0,0,not graded: not in a student's folder" in text
     assert sorted(p.name for p in (tmp_path / "out" / "feedback").iterdir()) == [
         "carol.html", "loose.ipynb.html", "nobody.html"]
 
@@ -197,7 +198,7 @@ def test_grade_tool_stops_a_notebook_past_its_limit_with_its_kernel(tmp_path: Pa
                                        cell_timeout=600, notebook_timeout=8)
     row = table.read_text(encoding="utf-8").splitlines()[1]
     assert graded == 1
-    assert row.startswith("dave,01_vision_only.ipynb,0,9,stopped: ran longer than the time "
+    assert row.startswith("dave,01_vision_only.ipynb,(a),0,9,stopped: ran longer than the time "
                           "limit of 8 s per notebook,not run,not run")
     left = []
     for process in psutil.process_iter(["cwd"]):
@@ -229,5 +230,10 @@ def test_grade_tool_gives_a_huge_submission_its_row(tmp_path: Path) -> None:
                                        cell_timeout=10, notebook_timeout=60)
     row = table.read_text(encoding="utf-8").splitlines()[1]
     assert graded == 1
-    assert row.startswith("erin,01_vision_only.ipynb,0,9,\"not graded: ")
+    assert row.startswith("erin,01_vision_only.ipynb,(a),0,9,\"not graded: ")
     assert "is 300 MB, larger than the 256 MB the tools read as a notebook" in row
+
+
+def test_question_labels() -> None:
+    assert [grading.question_label(p.name) for p in NOTEBOOKS] == [
+        NOTEBOOKS[0].name, "(a)", "(b)", "(c)", "(d)", "(e)", NOTEBOOKS[-1].name]

@@ -141,7 +141,7 @@ def test_grade_tool_gives_each_submission_its_points(graded: dict, student: str)
     for check, passed in PASSES[student].items():
         assert (row[check] == grade.PASSED) == passed, (check, row[check])
     assert row["automatic points"] == f"{expected_points(student):g}"
-    assert row["out of"] == "9"
+    assert (row["question"], row["out of"]) == ("(a)", "9")
 
 
 def test_grade_tool_and_nbgrader_agree(graded: dict) -> None:

@@ -47,7 +47,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.errors import error_line, first_line, shown, strip_colour
     from lqe_helpers.authoring.execution import positive_seconds
     from lqe_helpers.authoring.files import atomic_write_text
-    from lqe_helpers.authoring.grading import core_end, graded_cells
+    from lqe_helpers.authoring.grading import QUESTION_LABELS, core_end, graded_cells
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.task_cells import EXPLORER_TAG, SOLUTION_TAG, TASK_TAG, cell_tags
@@ -290,9 +290,11 @@ def _write_reports(rows: list, out: Path) -> Path:
     check_ids = list(dict.fromkeys(g for _, _, r in results for g in r["checks"]))
     text = io.StringIO()
     writer = csv.writer(text, lineterminator="\n")
-    writer.writerow(["student", "notebook", "automatic points", "out of", "error", *check_ids])
+    writer.writerow(["student", "notebook", "question", "automatic points", "out of", "error",
+                     *check_ids])
     for student, name, result in results:
-        writer.writerow([student, name, f"{result['points']:g}", f"{result['out_of']:g}",
+        writer.writerow([student, name, QUESTION_LABELS.get(name[:2], ""),
+                         f"{result['points']:g}", f"{result['out_of']:g}",
                          result["error"], *(result["checks"].get(g, "") for g in check_ids)])
     table = atomic_write_text(out / "grades.csv", text.getvalue())
     (out / "feedback").mkdir(exist_ok=True)

@@ -30,6 +30,13 @@ from lqe_helpers.authoring.task_cells import (
 ANSWER_SHARE = Fraction(2, 5)
 #: The check function a check cell calls (its name is the cell's grade id).
 CHECK_NAME = re.compile(r"\bchecks\.(check_\w+)\s*\(")
+#: The tutorial's question of each graded notebook, by its number.
+QUESTION_LABELS = {"01": "(a)", "02": "(b)", "03": "(c)", "04": "(d)", "05": "(e)"}
+
+
+def question_label(notebook_name: str) -> str:
+    """``(a)`` for ``01_vision_only…``; the notebook's name if it answers no question."""
+    return QUESTION_LABELS.get(notebook_name[:2], notebook_name)
 
 
 @dataclass(frozen=True)

@@ -16,13 +16,7 @@ from nbgrader.api import Gradebook, MissingEntry
 from nbgrader.plugins import ExportPlugin
 
 from lqe_helpers.authoring.files import atomic_write_text
-from lqe_helpers.authoring.marking_guide import NOTEBOOK_QUESTIONS, QUESTION_MARKS
-
-
-def question_label(notebook_name: str) -> str:
-    """``(a)`` for ``01_vision_only``; the notebook's name if it answers no question."""
-    question = NOTEBOOK_QUESTIONS.get(notebook_name[:2], notebook_name)
-    return f"({question})" if question in QUESTION_MARKS else question
+from lqe_helpers.authoring.grading import question_label
 
 
 class QuestionPointsExport(ExportPlugin):
