@@ -221,17 +221,21 @@ def test_graded_copy_keeps_a_task_that_calls_its_check() -> None:
 
 @pytest.mark.slow
 def test_grade_tool_gives_a_huge_submission_its_row(tmp_path: Path) -> None:
-    """A 300 MB file (sparse: no disk used) is refused by size, with its row."""
+    """A 300 MB file (sparse: no disk used) is refused by size, with its row; the kernel
+    folder a killed run left is removed."""
     subs = tmp_path / "subs"
     (subs / "erin").mkdir(parents=True)
     with (subs / "erin" / NAME).open("wb") as file:
         file.truncate(300 * 2**20)
+    stale = tmp_path / "out" / "results" / "erin" / f".work-{NAME}-left-by-a-killed-run"
+    stale.mkdir(parents=True)
     table, graded, _ = grade.grade_all(subs, tmp_path / "out", WORKED.parent, jobs=1,
                                        cell_timeout=10, notebook_timeout=60)
     row = table.read_text(encoding="utf-8").splitlines()[1]
     assert graded == 1
     assert row.startswith("erin,01_vision_only.ipynb,(a),0,9,\"not graded: ")
     assert "is 300 MB, larger than the 256 MB the tools read as a notebook" in row
+    assert [p.name for p in stale.parent.iterdir()] == [f"{NAME}.json"]
 
 
 def test_question_labels() -> None:

@@ -229,6 +229,7 @@ def _run_workers(todo: list, jobs: int, cell_timeout: float, notebook_timeout: f
         while todo or running:
             while todo and len(running) < jobs:
                 path, worked, result_path, digest = item = todo.pop(0)
+                _remove_side_files(result_path)
                 command = [sys.executable, "-m", "lqe_helpers.authoring.grade", "--one",
                            str(path), "--worked", str(worked), "--result", str(result_path),
                            "--sha256", digest, "--cell-timeout", str(cell_timeout)]
@@ -265,13 +266,19 @@ def _side_files(result_path: Path) -> tuple[Path, str]:
 
 def _stop(child: subprocess.Popen, result_path: Path) -> None:
     """Kill a worker, its kernel (in a session of its own) and the kernel's folder."""
-    pid_file, work_prefix = _side_files(result_path)
+    pid_file = _side_files(result_path)[0]
     for pid_of in (lambda: child.pid, lambda: int(pid_file.read_text())):
         try:
             os.killpg(pid_of(), signal.SIGKILL)
         except (OSError, ValueError):
             pass  # gone already, or no kernel started
     child.wait()
+    _remove_side_files(result_path)
+
+
+def _remove_side_files(result_path: Path) -> None:
+    """Remove a grading's kernel folder and process-id file (a killed run leaves them)."""
+    pid_file, work_prefix = _side_files(result_path)
     pid_file.unlink(missing_ok=True)
     for work in result_path.parent.glob(f"{work_prefix}*"):
         shutil.rmtree(work, ignore_errors=True)
