@@ -24,7 +24,8 @@ CHECK_VENV = if [ -e $(VENV) ] || [ -L $(VENV) ]; then reason=""; \
 	if [ -n "$$reason" ]; then \
 	  echo "error: .venv is broken ($$reason); run make clean, then make lab" >&2; exit 1; fi; fi
 
-.PHONY: lab test test-fast lint notebooks handouts student student-pack bench bench-browser clean
+.PHONY: lab test test-fast lint notebooks handouts student student-pack nbgrader bench \
+	bench-browser clean
 
 $(BIN)/python:
 	@$(CHECK_VENV)
@@ -35,6 +36,13 @@ $(STAMP): pyproject.toml $(CONSTRAINTS) | $(BIN)/python
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet $(CONSTRAINT_FLAG) -e '.[test]'
 	touch $(STAMP)
+
+# make test also runs the grading tests with real nbgrader: it adds the optional extra
+# `grading` to the same .venv (make lab and the student pack install only '.[test]').
+GRADING_STAMP := $(VENV)/.installed-grading
+$(GRADING_STAMP): $(STAMP)
+	$(BIN)/python -m pip install --quiet $(CONSTRAINT_FLAG) -e '.[test,grading]'
+	touch $(GRADING_STAMP)
 
 # JupyterLab on notebooks/. As root (a container, a cloud workspace) it adds --allow-root;
 # where no browser can open (Linux without $DISPLAY, $WAYLAND_DISPLAY or $BROWSER: ssh,
@@ -62,7 +70,7 @@ lint: $(STAMP)
 # slowest at the end. PYTEST_ARGS adds pytest options, and they win: PYTEST_ARGS="-n 0"
 # runs in this process (--pdb does so by itself), PYTEST_ARGS=--durations=60 lists more.
 PYTEST_PARALLEL := -n logical --dist loadfile --no-loadscope-reorder
-test: $(STAMP) lint
+test: $(GRADING_STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) --durations=15 tests --nbval notebooks \
 	  --nbval-current-env $(PYTEST_ARGS)
 
@@ -91,6 +99,12 @@ student: $(STAMP)
 # One zip for students, build/student-pack/lqe-student-pack.zip: unpack, then `make lab`.
 student-pack: $(STAMP)
 	$(BIN)/python -m lqe_helpers.authoring.student_pack --root . --out build/student-pack
+
+# An nbgrader course folder in build/nbgrader/: source/lqe/ (questions (a)-(e), core path, with
+# nbgrader cell metadata and points) and nbgrader_config.py. Run nbgrader there (pip install
+# -e '.[grading]'); see docs/instructors.md, "Grading a class".
+nbgrader: $(STAMP)
+	$(BIN)/python -m lqe_helpers.authoring.nbgrader_course --source notebooks --out build/nbgrader
 
 # Speed against a peer in the same process (ratios, not pass/fail): filter and sliders.
 bench: $(STAMP)

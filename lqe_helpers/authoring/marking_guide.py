@@ -37,6 +37,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.grading import graded_cells
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
     from lqe_helpers.authoring.task_cells import (
@@ -98,6 +99,7 @@ class Task:
     tolerance: str | None
     check_printed: str
     expected: list[str]
+    points: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -108,6 +110,7 @@ class Answer:
     heading: str
     text: str
     core: bool
+    points: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -244,6 +247,8 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
                          f"run `make notebooks` first")
     items: list[Task | Answer] = []
     core = True
+    points = {cell.index - (cell.kind == "check"): cell.points
+              for cell in graded_cells(notebook, marks) if cell.kind != "task"}
     for index, cell in enumerate(cells):
         tags = cell_tags(cell)
         where = cell_place(name, index, cell)
@@ -260,13 +265,13 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
                               ).strip() if check else ""
             items.append(Task(where, instruction, core, check,
                               check_tolerance(check) if check else None, printed,
-                              output_blocks(cell, where)))
+                              output_blocks(cell, where), points.get(index, 0.0)))
         elif ANSWER_TAG in tags:
             headings = answer_headings(cell.source)
             body = "\n".join(line for line in cell.source.splitlines()
                              if line.rstrip() not in headings).strip()
             heading = " ".join(line.lstrip("#").strip() for line in headings)
-            items.append(Answer(where, heading, body, core))
+            items.append(Answer(where, heading, body, core, points.get(index, 0.0)))
     meta = notebook.metadata.get("lqe", {})
     return NotebookGuide(name, question, marks, meta.get("core_minutes"), items)
 
@@ -291,6 +296,11 @@ def render(guides: Sequence[NotebookGuide], source: str = "notebooks") -> str:
         "with every check passing has the code of the core path right. The written answers "
         "(the student's *Your answer* cells) carry the judgement; their worked text below "
         "gives the points to look for.",
+        "",
+        "Points (the two grading routes, docs/instructors.md): on the core path, 40 % of a "
+        "question's marks go to its written answers (marked by hand), the rest is shared "
+        "equally by its checks (automatic: a check earns its points when it runs without "
+        "raising). Going further, notebook 00 and the bonus 06 carry no points.",
         "",
         "| Question | Marks | Notebook | Core time | Core tasks (with a check) | Written answers |",
         "| --- | --- | --- | --- | --- | --- |",
@@ -319,11 +329,13 @@ def _render_item(item: Task | Answer) -> list[str]:
     if isinstance(item, Answer):
         quoted = "\n".join(f"> {line}".rstrip() for line in item.text.splitlines())
         return [f"#### Written answer: {item.heading or '(no heading)'}", "",
-                f"*{item.place}.* Key points of the worked answer:", "", quoted, ""]
+                f"*{item.place}.* Points: {item.points:g}, marked by hand. Key points of the "
+                f"worked answer:", "", quoted, ""]
     lines = [f"#### Task: {item.instruction.removeprefix('Task:').strip()}", "",
              f"*{item.place}.*", ""]
     if item.check:
-        lines += [f"- **Check:** `{item.check}`", f"- **Tolerance:** {item.tolerance}"]
+        lines += [f"- **Check:** `{item.check}`", f"- **Tolerance:** {item.tolerance}",
+                  f"- **Points:** {item.points:g} (automatic)"]
         if item.check_printed:
             lines.append(f"- **The check printed:** {item.check_printed}")
     else:
