@@ -2,18 +2,17 @@
 
 from __future__ import annotations
 
-import ctypes
 import inspect
 import signal
 import sys
 import threading
-import time
 import types
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
 from .errors import NotWrittenYet, StudentCodeError, TimedOut, error_text, location
+from .running import run_in_thread, run_with_alarm
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -22,14 +21,6 @@ TIME_LIMIT = 5.0
 #: What the "not written yet" message tells the student to do.
 NOT_WRITTEN_ADVICE = ("replace the line `raise NotImplementedError` with your code, run its "
                       "cell, then {rerun}")
-
-
-class _TimeIsUp(BaseException):
-    """Raised inside a student's function when its time is up.
-
-    A ``BaseException``, not an ``Exception``: the student's ``except Exception`` does
-    not swallow it.
-    """
 
 
 def function_name(function: object) -> str:
@@ -70,73 +61,6 @@ def _restore(before: dict[types.ModuleType, dict[str, object]]) -> list[str]:
 
 
 _MISSING = object()
-
-
-def _run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str, object]:
-    """``function(*args)`` stopped after ``limit`` s by SIGALRM (main thread only)."""
-    state = {"armed": True, "fired": False}
-
-    def on_alarm(signum: int, frame: object) -> None:
-        if state["armed"]:
-            state["fired"] = True
-            raise _TimeIsUp
-
-    previous = signal.signal(signal.SIGALRM, on_alarm)
-    outer_delay, outer_interval = signal.setitimer(signal.ITIMER_REAL, limit)
-    start = time.monotonic()
-    try:
-        outcome: tuple[str, object] = ("returned", function(*args))
-    except _TimeIsUp as error:
-        outcome = ("timeout", error)
-    except BaseException as error:  # reported to the student, not hidden
-        outcome = ("raised", error)
-    finally:
-        state["armed"] = False
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, signal.SIG_DFL if previous is None else previous)
-        if outer_delay:  # an outer timer (e.g. pytest-timeout's) runs on, a little late
-            remaining = max(outer_delay - (time.monotonic() - start), 1e-3)
-            signal.setitimer(signal.ITIMER_REAL, remaining, outer_interval)
-    if state["fired"] and outcome[0] != "timeout":   # swallowed by a bare `except:`
-        outcome = ("timeout", outcome[1] if outcome[0] == "raised" else None)
-    return outcome
-
-
-def _run_in_thread(function: Callable, args: tuple, limit: float) -> tuple[str, object]:
-    """``function(*args)`` in a worker thread; after ``limit`` s it is sent :class:`_TimeIsUp`."""
-    box: dict[str, tuple[str, object]] = {}
-
-    def target() -> None:
-        try:
-            box["outcome"] = ("returned", function(*args))
-        except _TimeIsUp as error:
-            box["outcome"] = ("timeout", error)
-        except BaseException as error:  # reported to the student
-            box["outcome"] = ("raised", error)
-
-    worker = threading.Thread(target=target, name="student code", daemon=True)
-    worker.start()
-    try:
-        worker.join(limit)
-    except KeyboardInterrupt:  # the kernel was interrupted while waiting
-        _stop_thread(worker, KeyboardInterrupt)
-        worker.join(1.0)
-        return box.get("outcome", ("raised", KeyboardInterrupt()))
-    if worker.is_alive():
-        _stop_thread(worker, _TimeIsUp)
-        worker.join(1.0)
-        outcome = box.get("outcome")
-        return ("timeout", outcome[1] if outcome and outcome[0] != "returned" else None)
-    return box["outcome"]
-
-
-def _stop_thread(worker: threading.Thread, kind: type[BaseException]) -> None:
-    """Raise ``kind`` inside ``worker`` at its next line of Python (CPython only)."""
-    try:
-        ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(worker.ident),
-                                                   ctypes.py_object(kind))
-    except (AttributeError, TypeError):  # not CPython: the thread runs on in the background
-        pass
 
 
 class _Tripped(BaseException):
@@ -199,15 +123,16 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
 
     Array arguments are copied, so the student's function cannot change the caller's
     data. The function runs for at most ``time_limit`` seconds: in the main thread where
-    the system has ``SIGALRM`` (Linux, macOS: a Jupyter kernel, pytest) a timer raises an
-    exception inside it that its own ``except Exception`` cannot swallow, and the previous
-    SIGALRM handler and timer are restored afterwards (an outer timer is re-armed with its
-    remaining time, late by at most this call's duration). Elsewhere (off the main thread,
-    or on Windows) the function runs in a worker thread that is sent the same exception
-    after ``time_limit`` seconds; a thread stuck inside one long C call (a huge numpy
-    operation, ``time.sleep``) is then left to finish in the background while this call
-    reports the time-out. Either way only Python code is interrupted: a single numpy call
-    runs to its end.
+    the system has ``SIGALRM`` (Linux, macOS: a Jupyter kernel, pytest) a timer stops it,
+    and the previous SIGALRM handler and timer are restored afterwards (an outer timer is
+    re-armed with its remaining time, late by at most this call's duration). Elsewhere
+    (off the main thread, or on Windows) the function runs in a worker thread that is
+    stopped the same way; a thread stuck inside one long C call (a huge numpy operation,
+    ``time.sleep``) is then left to finish in the background while this call reports the
+    time-out. Either way the stop is raised again at every line the function runs until it
+    has ended, so not even a bare ``except:`` inside a loop outlasts it
+    (:mod:`~lqe_helpers.student_code.running`); only Python code is stopped: a single numpy
+    call runs to its end.
 
     These guard against a student's mistakes, not against deliberate cheating: code in the
     same process that switches the timer off or reads the caller's frames is not stopped.
@@ -265,7 +190,7 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     copies = tuple(_copy(arg) for arg in args)
     before = _snapshot()
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
-    run = _run_with_alarm if alarm else _run_in_thread
+    run = run_with_alarm if alarm else run_in_thread
     watch = _Watch(forbid)
     kind, value = run(watch.wrap(function), copies, float(time_limit))
     replaced = _restore(before)
