@@ -26,7 +26,7 @@ from .errors import (
     is_own_code,
     own_frames,
 )
-from .keeping import SAVE_FOLDER, SAVE_HEADER, SAVED_BY, load, save
+from .keeping import SAVE_FOLDER, SAVE_HEADER, SAVED_BY, load, save, save_folder
 from .results import MAX_MAGNITUDE, array_problem, result_array
 
 __all__ = [
@@ -50,4 +50,5 @@ __all__ = [
     "own_frames",
     "result_array",
     "save",
+    "save_folder",
 ]

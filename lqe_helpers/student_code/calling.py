@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import inspect
+import os
 import signal
 import sys
 import threading
@@ -61,6 +62,25 @@ def _restore(before: dict[types.ModuleType, dict[str, object]]) -> list[str]:
 
 
 _MISSING = object()
+
+
+def _working_folder() -> str | None:
+    try:
+        return os.getcwd()
+    except OSError:  # the working folder was deleted
+        return None
+
+
+def _restore_working_folder(before: str | None) -> str | None:
+    """Go back to the working folder ``before`` if the call left it; the folder it left."""
+    now = _working_folder()
+    if before is None or now == before:
+        return None
+    try:
+        os.chdir(before)
+    except OSError:  # deleted meanwhile: nothing to go back to
+        pass
+    return now or "a folder that no longer exists"
 
 
 class _Tripped(BaseException):
@@ -174,8 +194,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         If ``function`` is not callable, raised any other exception (including
         ``SystemExit`` and ``KeyboardInterrupt``), did not return within the limit,
         changed an input in place (with ``arg_names``), replaced a function of the pack
-        or of numpy (restored first), ran a function of ``forbid``, or is an ``async``
-        function. One line: the type,
+        or of numpy (restored first), changed the working folder (changed back first),
+        ran a function of ``forbid``, or is an ``async`` function. One line: the type,
         message and the line of the student's own code where it happened.
     """
     name = name or function_name(function)
@@ -188,12 +208,13 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     if not (isinstance(time_limit, (int, float)) and 0 < time_limit < float("inf")):
         raise ValueError(f"time_limit must be a number of seconds > 0, got {time_limit!r}")
     copies = tuple(_copy(arg) for arg in args)
-    before = _snapshot()
+    before, folder = _snapshot(), _working_folder()
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     run = run_with_alarm if alarm else run_in_thread
     watch = _Watch(forbid)
     kind, value = run(watch.wrap(function), copies, float(time_limit))
     replaced = _restore(before)
+    moved = _restore_working_folder(folder)
     if watch.tripped:
         raise StudentCodeError(
             f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "
@@ -211,6 +232,10 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     if kind == "raised":
         assert isinstance(value, BaseException)
         raise _raised(value, name, on, arg_names, hint, shape_hint, rerun)
+    if moved:
+        raise StudentCodeError(
+            f"{name} changed the working folder (os.chdir) to {moved} (now changed back){on}: "
+            f"a function must compute its result, not move the notebook to another folder")
     if replaced:
         raise StudentCodeError(
             f"{name} replaced {', '.join(replaced[:3])}{' …' * (len(replaced) > 3)} (now "
