@@ -138,7 +138,8 @@ def _copy(value: object) -> object:
 def call(function: Callable, *args: object, name: str | None = None, where: str = "",
          time_limit: float | None = None, arg_names: Sequence[str] | None = None,
          hint: str = "", shape_hint: str = "", rerun: str = "run this check again",
-         forbid: Sequence[Callable] = ()) -> object:
+         forbid: Sequence[Callable] = (),
+         failure: type[StudentCodeError] = StudentCodeError) -> object:
     """Call a student's function on copies of ``args`` under a time limit.
 
     Array arguments are copied, so the student's function cannot change the caller's
@@ -180,6 +181,9 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         Functions of the pack that hold the task's answer (the engine's eq. (5), say).
         If the student's function runs one of them, directly or through anything it
         calls, the call fails: the task is to write it, not to call the pack's.
+    failure : subclass of StudentCodeError
+        What a failure other than :class:`NotWrittenYet` and :class:`TimedOut` raises: a
+        check passes :class:`~lqe_helpers.student_code.errors.CheckFailed`.
 
     Returns
     -------
@@ -201,7 +205,7 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     name = name or function_name(function)
     on = f", on {where}" if where else ""
     if not callable(function):
-        raise StudentCodeError(
+        raise failure(
             f"{name} must be a function (its name, without parentheses), got a "
             f"{type(function).__name__}")
     time_limit = TIME_LIMIT if time_limit is None else time_limit
@@ -216,40 +220,40 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     replaced = _restore(before)
     moved = _restore_working_folder(folder)
     if watch.tripped:
-        raise StudentCodeError(
+        raise failure(
             f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "
             f"yourself, from the equation, with NumPy (@, np.linalg), not to call the pack's "
             f"solution")
     if kind == "timeout":
         error = value if isinstance(value, BaseException) else None
-        failure = TimedOut(
+        stopped = TimedOut(
             f"{name} did not return within {time_limit:g} s"
             f"{location(error.__traceback__) if error else ''}{on}: is there a loop that "
             f"never ends (a while loop whose condition never turns false), or one over far "
             f"more steps than its input has?")
-        failure.student_traceback = error.__traceback__ if error else None
-        raise failure
+        stopped.student_traceback = error.__traceback__ if error else None
+        raise stopped
     if kind == "raised":
         assert isinstance(value, BaseException)
-        raise _raised(value, name, on, arg_names, hint, shape_hint, rerun)
+        raise _raised(value, name, on, arg_names, hint, shape_hint, rerun, failure)
     if moved:
-        raise StudentCodeError(
+        raise failure(
             f"{name} changed the working folder (os.chdir) to {moved} (now changed back){on}: "
             f"a function must compute its result, not move the notebook to another folder")
     if replaced:
-        raise StudentCodeError(
+        raise failure(
             f"{name} replaced {', '.join(replaced[:3])}{' …' * (len(replaced) > 3)} (now "
             f"restored){on}: a function must compute its result, not change the pack's or "
             f"numpy's code")
     if inspect.iscoroutine(value):
         value.close()
-        raise StudentCodeError(f"{name} is an async function (async def); write it with a "
+        raise failure(f"{name} is an async function (async def); write it with a "
                                f"plain def")
     if arg_names is not None:
         for label, given, original in zip(arg_names, copies, args, strict=False):
             if isinstance(original, np.ndarray) and not np.array_equal(
                     given, original, equal_nan=original.dtype.kind in "fc"):
-                raise StudentCodeError(
+                raise failure(
                     f"{name} changed its input {label} in place{on}. A function must leave "
                     f"its inputs unchanged: work on new arrays instead of modifying {label} "
                     f"(e.g. with += or an assignment to {label}[...])")
@@ -257,10 +261,15 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
 
 
 def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] | None,
-            hint: str, shape_hint: str, rerun: str) -> StudentCodeError:
-    """The StudentCodeError reporting ``error``, raised by the student's function."""
-    if isinstance(error, StudentCodeError):  # already one line for the student (a stand-in's)
-        return error
+            hint: str, shape_hint: str, rerun: str,
+            failure: type[StudentCodeError] = StudentCodeError) -> StudentCodeError:
+    """The ``failure`` reporting ``error``, raised by the student's function."""
+    if isinstance(error, (failure, NotWrittenYet, TimedOut)):
+        return error                      # already one line for the student
+    if isinstance(error, StudentCodeError):  # a stand-in's or a guard's: its line, as failure
+        reported = failure(str(error))
+        reported.student_traceback = error.student_traceback or error.__traceback__
+        return reported
     if isinstance(error, NotImplementedError):
         return NotWrittenYet(
             f"{name} is not written yet: {NOT_WRITTEN_ADVICE.format(rerun=rerun)}")
@@ -283,7 +292,7 @@ def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] |
     else:
         said = f": {text}" if text else ""
         message = f"{name} raised {kind}{said}{at}{on}.{extra}"
-    failure = StudentCodeError(message)
-    failure.student_traceback = error.__traceback__
-    return failure
+    reported = failure(message)
+    reported.student_traceback = error.__traceback__
+    return reported
 

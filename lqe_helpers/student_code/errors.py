@@ -49,16 +49,26 @@ class StudentCodeError(OwnCodeTraceback, Exception):
     """A student's function failed, hung or returned something unusable.
 
     Its message is one line, written for the student (what went wrong and where), with
-    no library code in it. Checks turn it into a failed check; explorers show it in
-    their numbers line instead of a picture.
+    no library code in it. Explorers show it in their numbers line instead of a picture.
+    The pack's one hierarchy of errors for students: checks raise its subclass
+    :class:`CheckFailed` (``student_code.call(..., failure=CheckFailed)``).
     """
 
 
-class NotWrittenYet(StudentCodeError):
+class CheckFailed(StudentCodeError, AssertionError):
+    """A task's answer is not right yet; the message says what is wrong.
+
+    An ``AssertionError``, so "Run All" stops at the wrong step. In Jupyter it shows the
+    student's own cells and the message only (:class:`OwnCodeTraceback`). Every check of
+    :mod:`lqe_helpers.checks` raises it (``checks.machinery`` re-exports it).
+    """
+
+
+class NotWrittenYet(CheckFailed):
     """The student's function still raises ``NotImplementedError`` (the stub)."""
 
 
-class TimedOut(StudentCodeError):
+class TimedOut(CheckFailed):
     """The student's function did not return within its time limit (and was stopped)."""
 
 
