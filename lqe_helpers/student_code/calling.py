@@ -24,10 +24,13 @@ NOT_WRITTEN_ADVICE = ("replace the line `raise NotImplementedError` with your co
                       "cell, then {rerun}")
 
 
-def function_name(function: object) -> str:
-    """The name a message gives the student's function ("your function" for a lambda)."""
+def function_name(function: object, *, yours: bool = False) -> str:
+    """The name a message gives the student's function: ``my_filter``, or "your function"
+    for a lambda; with ``yours``, "your my_filter" (and still "your function")."""
     name = getattr(function, "__name__", None)
-    return name if isinstance(name, str) and name.isidentifier() else "your function"
+    if not (isinstance(name, str) and name.isidentifier()):
+        return "your function"
+    return f"your {name}" if yours else name
 
 
 #: numpy modules whose attributes a student's function must leave alone, besides every
