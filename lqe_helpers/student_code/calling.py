@@ -8,6 +8,7 @@ import signal
 import sys
 import threading
 import types
+import warnings
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -65,6 +66,19 @@ def _restore(before: dict[types.ModuleType, dict[str, object]]) -> list[str]:
 
 
 _MISSING = object()
+
+#: How many calls of :func:`call` are running now (in any thread).
+_depth = 0
+
+
+def inside_call() -> bool:
+    """Whether a :func:`call` is running, which reports its function's errors itself."""
+    return _depth > 0
+
+
+def reported(error: BaseException, name: str) -> StudentCodeError:
+    """The one-line StudentCodeError of :func:`call` for ``error``, raised by ``name``."""
+    return _raised(error, name, "", None, "", "", "run this cell again")
 
 
 def _working_folder() -> str | None:
@@ -193,6 +207,9 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     object
         What the function returned, unchecked (see :func:`result_array`).
 
+    Warnings the function gives (numpy's "overflow encountered", say) are not printed: a
+    failure's message quotes them; a call that returns drops them.
+
     Raises
     ------
     NotWrittenYet
@@ -219,7 +236,14 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
     run = run_with_alarm if alarm else run_in_thread
     watch = _Watch(forbid)
-    kind, value = run(watch.wrap(function), copies, float(time_limit))
+    global _depth
+    _depth += 1
+    try:
+        with warnings.catch_warnings(record=True) as warned:  # shown only in a failure
+            warnings.simplefilter("always")
+            kind, value = run(watch.wrap(function), copies, float(time_limit))
+    finally:
+        _depth -= 1
     replaced = _restore(before)
     moved = _restore_working_folder(folder)
     if watch.tripped:
@@ -238,6 +262,7 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         raise stopped
     if kind == "raised":
         assert isinstance(value, BaseException)
+        hint = " ".join(part for part in (hint, _warnings_text(warned)) if part)
         raise _raised(value, name, on, arg_names, hint, shape_hint, rerun, failure)
     if moved:
         raise failure(
@@ -261,6 +286,16 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
                     f"its inputs unchanged: work on new arrays instead of modifying {label} "
                     f"(e.g. with += or an assignment to {label}[...])")
     return value
+
+
+def _warnings_text(warned: list[warnings.WarningMessage]) -> str:
+    """What the warnings a student's function gave say, for its failure's message."""
+    said = list(dict.fromkeys(f"{type(item.message).__name__}: {error_text(item.message)}"
+                              for item in warned))
+    if not said:
+        return ""
+    more = f" and {len(said) - 2} more" if len(said) > 2 else ""
+    return f"Before that it warned: {'; '.join(said[:2])}{more}."
 
 
 def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] | None,
