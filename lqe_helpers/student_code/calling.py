@@ -239,8 +239,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     global _depth
     _depth += 1
     try:
-        with warnings.catch_warnings(record=True) as warned:  # shown only in a failure
-            warnings.simplefilter("always")
+        # Recorded, not printed (the filters in force still apply: "error" still raises).
+        with warnings.catch_warnings(record=True) as warned:
             kind, value = run(watch.wrap(function), copies, float(time_limit))
     finally:
         _depth -= 1
