@@ -18,6 +18,11 @@ import numpy as np
 from . import experiments, metrics, model, validation
 from .scenario import Scenario
 
+#: Most σ_j values :func:`tune_jerk_std` accepts in one grid. Each value runs the filter over
+#: every Monte Carlo run (about 0.1 s at the scenario's 300 runs), so 200 values take about
+#: 20 s; notebook 00's grid has 17. A longer grid is refused before anything runs.
+MAX_GRID_SIZE = 200
+
 
 @dataclass(frozen=True)
 class JerkChoice:
@@ -99,7 +104,7 @@ def tune_jerk_std(scenario: Scenario, jerk_stds: Sequence[float] | np.ndarray,
     scenario : Scenario
         Everything but σ_j; its seed fixes the draws, shared by every σ_j.
     jerk_stds : array_like, shape (g,)
-        σ_j values (cm/s³), > 0, increasing, g >= 3.
+        σ_j values (cm/s³), > 0, increasing, 3 <= g <= :data:`MAX_GRID_SIZE`.
     sensors : sequence of str
         As for :func:`~lqe_helpers.experiments.track`.
     runs : int, optional
@@ -110,6 +115,11 @@ def tune_jerk_std(scenario: Scenario, jerk_stds: Sequence[float] | np.ndarray,
     JerkChoice
     """
     validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    size = validation.elements(np.shape(jerk_stds))  # before any work on the values
+    if size > MAX_GRID_SIZE:
+        raise ValueError(
+            f"jerk_stds must hold at most {MAX_GRID_SIZE} values (jerk_tuning.MAX_GRID_SIZE: "
+            f"each runs the filter over every run, about 0.1 s), got {size} values")
     grid = validation.positive_array("jerk_stds", jerk_stds, "cm/s³", min_ndim=1)
     if grid.ndim != 1 or grid.size < 3 or np.any(np.diff(grid) <= 0):
         raise ValueError(f"jerk_stds must be an increasing grid of at least 3 values, got "

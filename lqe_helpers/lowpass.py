@@ -169,6 +169,9 @@ def noise_variance(lowpass: LowPass) -> np.ndarray:
     validation.instance("lowpass", lowpass, LowPass, "from steady_lowpass()")
     M, K = lowpass.closed_loop, lowpass.gain
     k = M.shape[-1]
+    validation.check_memory(f"a filter of k = {k} states with a batch of shape "
+                            f"{M.shape[:-2]}", validation.elements(M.shape[:-2]) * k**4,
+                            copies=3, what="for its Kronecker products (k⁴ numbers each)")
     driven = K @ lowpass.noise @ K.mT
     kron = M[..., :, None, :, None] * M[..., None, :, None, :]   # (M ⊗ M)[(i,j),(a,b)]
     system = np.eye(k * k) - kron.reshape(*M.shape[:-2], k * k, k * k)

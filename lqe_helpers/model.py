@@ -110,13 +110,17 @@ def measurement_noise_covariance(sigmas: Sequence[float] | np.ndarray) -> np.nda
     ----------
     sigmas : array_like, shape (..., m)
         Sensor noise standard deviations in cm, each > 0. Leading axes are batch axes,
-        so a sweep over σ gives a stack of R matrices.
+        so a sweep over σ gives a stack of R matrices. R's size is refused beyond
+        :data:`~lqe_helpers.validation.MEMORY_LIMIT_BYTES` (ValueError), before it is made.
 
     Returns
     -------
     ndarray, shape (..., m, m)
     """
     sigmas = validation.finite_array("sigmas", sigmas, min_ndim=1)
+    validation.check_memory(f"sigmas of shape {sigmas.shape}",
+                            validation.elements(sigmas.shape) * (sigmas.shape[-1] + 1),
+                            what="for R, one row and column per sensor")
     if np.any(sigmas <= 0):
         raise ValueError(f"sigmas must all be > 0 cm, got {np.ravel(sigmas)[:6].tolist()}")
     validation.in_float_range(

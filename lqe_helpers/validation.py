@@ -276,8 +276,12 @@ def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
 
 
 def _describe_raw(value: object) -> str:
-    """``repr`` of a value that may not convert to an array, shortened if long."""
+    """A value that may not convert to an array, on one line: its ``repr`` if short, else
+    an array's shape and dtype (or the start of the repr)."""
     text = repr(value)
+    if isinstance(value, np.ndarray) and ("\n" in text or len(text) > 80):
+        return f"an array of shape {value.shape} and dtype {value.dtype}"
+    text = " ".join(text.split())
     return text if len(text) <= 80 else f"{text[:60]} … (a {type(value).__name__})"
 
 

@@ -129,3 +129,12 @@ def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]):
         else:
             report.sections.append(("kernel marker", message))
     return report
+
+
+@pytest.fixture(autouse=True)
+def _fresh_save_folder(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Each test is a new session for ``student_code.save``/``load``: their default folder
+    is fixed at a test's first use, in the folder it works in (see ``keeping.save_folder``)."""
+    from lqe_helpers.student_code import keeping
+
+    monkeypatch.setattr(keeping, "_home", None, raising=False)

@@ -8,6 +8,7 @@ allocations) records no more than the inputs' own size (under 64 MiB here).
 from __future__ import annotations
 
 import dataclasses
+import time
 import tracemalloc
 
 import numpy as np
@@ -140,3 +141,49 @@ def test_the_packs_largest_call_fits_under_the_limit() -> None:
 def test_a_scenario_one_hour_long_is_still_allowed() -> None:
     scenario = dataclasses.replace(DEFAULT, duration=3600.0)
     assert scenario.n_steps == 360_000
+
+
+# ------------------------------------------------------------------------------------------
+# Issue 27: sizes that used to be accepted (a run of days) or failed with numpy's MemoryError
+# ------------------------------------------------------------------------------------------
+
+
+def test_a_grid_of_sigma_j_beyond_its_limit_is_refused_at_once() -> None:
+    from lqe_helpers import jerk_tuning
+
+    grid = np.linspace(1, 2000, 10**7)
+    start = time.monotonic()
+    with pytest.raises(ValueError, match=r"^jerk_stds must hold at most 200 values "
+                                         r"\(jerk_tuning.MAX_GRID_SIZE: .*\), got 10000000 "
+                                         r"values$"):
+        jerk_tuning.tune_jerk_std(DEFAULT, grid)
+    assert time.monotonic() - start < 0.5
+    assert jerk_tuning.MAX_GRID_SIZE == 200
+
+
+def _refused_before_allocation(call, message: str) -> None:
+    tracemalloc.start()
+    try:
+        with pytest.raises(ValueError, match=message):
+            call()
+        _, peak = tracemalloc.get_traced_memory()
+    finally:
+        tracemalloc.stop()
+    assert peak < 64 * 1024**2
+
+
+def test_r_sized_from_the_number_of_sigmas_is_refused_before_it_is_made() -> None:
+    sigmas = np.ones(10**5)
+    _refused_before_allocation(
+        lambda: model.measurement_noise_covariance(sigmas),
+        r"^sigmas of shape \(100000,\) would need about 74.5 GiB for R, one row and column per "
+        r"sensor, more than the limit of 2 GiB")
+
+
+def test_the_kronecker_products_of_a_large_filter_are_refused_before_they_are_made() -> None:
+    k = 100    # k⁴ = 10⁸ numbers per product
+    large = lowpass.steady_lowpass(0.5 * np.eye(k), np.eye(1, k), np.eye(k), [[1.0]], 0.01)
+    _refused_before_allocation(
+        lambda: lowpass.noise_variance(large),
+        r"^a filter of k = 100 states with a batch of shape \(\) would need about 2.24 GiB for "
+        r"its Kronecker products")

@@ -45,6 +45,25 @@ def my_filter(y, A, C, Q, R, z0, P0):
             pass
     return np.array(rows)"""
 CHECK = "checks.check_filter(my_filter)"
+SAVED_RAISING = """\
+# Written by lqe_helpers.student_code.save: edit the notebook, not this file.
+import numpy as np
+
+def my_filter(y, A, C, Q, R, z0, P0):
+    for y_j in y:
+        gain = 1 / 0
+    return y
+"""
+LATER_CALL = """\
+import numpy as np
+my_filter = student_code.load('my_filter')
+my_filter(np.zeros((3, 1)), np.eye(1), np.eye(1), np.eye(1), np.eye(1), np.zeros(1), np.eye(1))"""
+READ_ONLY = """\
+student_code.brief_errors()
+P_close = np.eye(3)
+P_close.flags.writeable = False
+P = P_close
+P += np.eye(3)"""
 SAVE = """\
 def doubled(x):
     return 2 * np.asarray(x)
@@ -128,9 +147,27 @@ def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
         "its arguments, numpy as np and Python's built-ins. Pass the others in as arguments (or "
         "compute them inside), run its cell, then this one again")
     assert_only_the_students_code(shown)
+    (folder / "my_functions" / "my_filter.py").write_text(SAVED_RAISING, "utf-8")
     later = run(["from lqe_helpers import student_code\n"
-                 "print(student_code.load('doubled')([1, 2]))"], folder)
+                 "print(student_code.load('doubled')([1, 2]))", LATER_CALL, READ_ONLY],
+                folder)
     assert later.cells[0].outputs[0].text == "[2 4]\n"
+    # A saved my_filter that raises in a later notebook: the student's lines (the cell, the
+    # saved file) and one message, not the source of the pack's inputs guard.
+    name, shown = error_of(later.cells[1])
+    assert name == "StudentCodeError"
+    assert shown.rstrip().endswith(
+        "StudentCodeError: my_filter raised ZeroDivisionError: division by zero (in "
+        "my_filter, line 6 of my_filter.py: `gain = 1 / 0`).")
+    assert "----> 6         gain = 1 / 0" in shown and "guards" not in shown
+    assert_only_the_students_code(shown)
+    # numpy's "assignment destination is read-only" names the array and how to copy it.
+    name, shown = error_of(later.cells[2])
+    assert name == "ValueError"
+    assert shown.rstrip().endswith("ValueError: P_close is read-only: copy it "
+                                   "(P = P_close.copy()) before changing P in place")
+    assert "numpy" not in shown and "assignment destination" not in shown
+    (folder / "my_functions" / "my_filter.py").unlink()
     # Not saved yet: loading says so in one line and gives a stand-in, so the notebook runs
     # on; using the stand-in is the error, with only the student's code shown.
     missing = run(["from lqe_helpers import student_code",

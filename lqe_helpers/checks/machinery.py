@@ -1,4 +1,4 @@
-"""What every check shares: CheckFailed, tolerances, calling the student's code, arguments.
+"""What every check shares: tolerances, calling the student's code, arguments.
 
 Every check runs a student's function through :func:`call_student` (the time limit and the
 one-line reports of :mod:`lqe_helpers.student_code`), reads what it returned with
@@ -6,7 +6,9 @@ one-line reports of :mod:`lqe_helpers.student_code`), reads what it returned wit
 :func:`argument_array`, :func:`positive_number`, :func:`shaped_argument` or
 :func:`keyed_entries` (a dict keyed as the task asks), so that a wrong type or shape is one
 :class:`CheckFailed` naming the argument. ``__tracebackhide__`` keeps these frames out of
-pytest's report; :class:`CheckFailed` keeps them out of Jupyter's.
+pytest's report; :class:`CheckFailed` keeps them out of Jupyter's. :class:`CheckFailed`,
+:class:`NotWrittenYet` and :class:`TimedOut` are :mod:`lqe_helpers.student_code`'s (one
+hierarchy of errors for students, re-exported here).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from collections.abc import Callable, Hashable, Mapping, Sequence
 import numpy as np
 
 from .. import student_code
-from ..student_code import OwnCodeTraceback, StudentCodeError, calling
+from ..student_code import CheckFailed, NotWrittenYet, TimedOut, calling
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -46,22 +48,6 @@ INTERVAL_RTOL = 1e-9
 
 #: Tolerance used when matching a wrong answer of a function against a typical mistake.
 MISTAKE_RTOL = 1e-6
-
-
-class CheckFailed(OwnCodeTraceback, AssertionError):
-    """A task's answer is not right yet; the message says what is wrong.
-
-    An ``AssertionError``, so "Run All" stops at the wrong step. In Jupyter it shows the
-    student's own cells and the message only (:class:`~lqe_helpers.student_code.OwnCodeTraceback`).
-    """
-
-
-class NotWrittenYet(CheckFailed):
-    """The student's function still raises NotImplementedError."""
-
-
-class TimedOut(CheckFailed):
-    """The student's function did not return within the time limit."""
 
 
 #: Failures after which a check calls the student's function no more (it would not help).
@@ -102,31 +88,18 @@ def call_student(function: Callable, *args: object, name: str, where: str,
                  arg_names: Sequence[str] | None = None, hint: str = "",
                  shape_hint: str = "", forbid: Sequence[Callable] = (),
                  allow: Sequence[Callable] = ()) -> object:
-    """``student_code.call`` for a check: every failure becomes one CheckFailed.
+    """``student_code.call`` for a check: every failure is one CheckFailed.
 
     The student's function may run no function of the pack but those of ``allow`` (a
     function task writes its answer itself: ``forbid_pack``, see
-    :mod:`lqe_helpers.checks.own_work`).
-
-    NotImplementedError becomes :class:`NotWrittenYet` and a time-out :class:`TimedOut`
-    (:data:`STOP_CALLING`: a check stops at once, calling again would not help);
-    everything else (an exception, an input changed in place, a ``forbid`` function of the
-    pack run, ...) a :class:`CheckFailed` with the same message that shows the student's
-    own lines where it happened.
+    :mod:`lqe_helpers.checks.own_work`). :class:`NotWrittenYet` and :class:`TimedOut`
+    (both CheckFailed) are :data:`STOP_CALLING`: a check stops at once, calling again would
+    not help; everything else (an exception, an input changed in place, a function of the
+    pack run, ...) is a CheckFailed that shows the student's own lines where it happened.
     """
-    try:
-        return student_code.call(function, *args, name=name, where=where, arg_names=arg_names,
-                                 hint=hint, shape_hint=shape_hint, forbid=forbid,
-                                 forbid_pack=True, allow=allow)
-    except student_code.NotWrittenYet as error:
-        failure: CheckFailed = NotWrittenYet(str(error))
-    except student_code.TimedOut as error:
-        failure = TimedOut(str(error))
-        failure.student_traceback = error.student_traceback
-    except StudentCodeError as error:
-        failure = CheckFailed(str(error))
-        failure.student_traceback = error.student_traceback
-    raise failure
+    return student_code.call(function, *args, name=name, where=where, arg_names=arg_names,
+                             hint=hint, shape_hint=shape_hint, forbid=forbid,
+                             forbid_pack=True, allow=allow, failure=CheckFailed)
 
 
 def answers_on_cases(cases: Sequence[object], call: Callable[[object], object],
@@ -161,12 +134,9 @@ def student_result(value: object, *, name: str, what: str,
 
     Floats of less than double precision are refused: a function check compares to 1e-9.
     """
-    try:
-        return student_code.result_array(value, name=name, what=what, shape=shape,
-                                         allow_nan=allow_nan, double=True, where=where)
-    except StudentCodeError as error:
-        failure = CheckFailed(str(error))
-    raise failure
+    return student_code.result_array(value, name=name, what=what, shape=shape,
+                                     allow_nan=allow_nan, double=True, where=where,
+                                     failure=CheckFailed)
 
 
 # ------------------------------------------------------------------------------------------

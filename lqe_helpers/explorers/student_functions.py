@@ -44,7 +44,7 @@ def checked_function(name: str, function: object) -> Callable[..., object] | Non
 
 def whose(function: Callable[..., object] | None, engine: str = ENGINE) -> str:
     """Who made the estimates: "your my_filter", or ``engine`` for None."""
-    return engine if function is None else f"your {student_code.function_name(function)}"
+    return engine if function is None else student_code.function_name(function, yours=True)
 
 
 def refiltered(tracking: experiments.Tracking, filter: StudentFilter | None,

@@ -5,9 +5,12 @@ explorers' sliders) calls it through :func:`call` and reads what it returned thr
 :func:`result_array`, so a student's function is run, timed and reported in one way
 everywhere; :func:`save` and :func:`load` carry a function from one notebook to the next.
 
-- ``errors``: :class:`StudentCodeError` (what every caller reports, one line) and
-  :class:`OwnCodeTraceback` (in Jupyter, only the student's own frames are shown);
-- ``calling``: :func:`call`, with copies of the inputs and a time limit;
+- ``errors``: :class:`StudentCodeError` (what every caller reports, one line), its
+  subclass :class:`CheckFailed` (what a check raises; :class:`NotWrittenYet` and
+  :class:`TimedOut` are both), and :class:`OwnCodeTraceback` (in Jupyter, only the
+  student's own frames are shown): the pack's one hierarchy of errors for students;
+- ``calling``: :func:`call`, with copies of the inputs and a time limit (``running``: a
+  time limit the student's own code cannot catch);
 - ``results``: :func:`result_array` and :func:`array_problem`, a real number array or
   one line saying what came instead;
 - ``keeping``: :func:`save` and :func:`load`;
@@ -17,6 +20,7 @@ everywhere; :func:`save` and :func:`load` carry a function from one notebook to 
 
 from .calling import NOT_WRITTEN_ADVICE, TIME_LIMIT, call, function_name
 from .errors import (
+    CheckFailed,
     NotSavedYet,
     NotWrittenYet,
     OwnCodeTraceback,
@@ -26,7 +30,7 @@ from .errors import (
     is_own_code,
     own_frames,
 )
-from .keeping import SAVE_FOLDER, SAVE_HEADER, SAVED_BY, load, save
+from .keeping import SAVE_FOLDER, SAVE_HEADER, SAVED_BY, load, save, save_folder
 from .results import MAX_MAGNITUDE, array_problem, result_array
 
 __all__ = [
@@ -36,6 +40,7 @@ __all__ = [
     "SAVE_FOLDER",
     "SAVE_HEADER",
     "TIME_LIMIT",
+    "CheckFailed",
     "NotSavedYet",
     "NotWrittenYet",
     "OwnCodeTraceback",
@@ -50,4 +55,5 @@ __all__ = [
     "own_frames",
     "result_array",
     "save",
+    "save_folder",
 ]

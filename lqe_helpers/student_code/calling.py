@@ -2,21 +2,21 @@
 
 from __future__ import annotations
 
-import ctypes
 import functools
 import inspect
 import os
 import signal
 import sys
 import threading
-import time
 import types
+import warnings
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from .errors import NotWrittenYet, StudentCodeError, TimedOut, error_text, location
+from .running import run_in_thread, run_with_alarm
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -27,18 +27,13 @@ NOT_WRITTEN_ADVICE = ("replace the line `raise NotImplementedError` with your co
                       "cell, then {rerun}")
 
 
-class _TimeIsUp(BaseException):
-    """Raised inside a student's function when its time is up.
-
-    A ``BaseException``, not an ``Exception``: the student's ``except Exception`` does
-    not swallow it.
-    """
-
-
-def function_name(function: object) -> str:
-    """The name a message gives the student's function ("your function" for a lambda)."""
+def function_name(function: object, *, yours: bool = False) -> str:
+    """The name a message gives the student's function: ``my_filter``, or "your function"
+    for a lambda; with ``yours``, "your my_filter" (and still "your function")."""
     name = getattr(function, "__name__", None)
-    return name if isinstance(name, str) and name.isidentifier() else "your function"
+    if not (isinstance(name, str) and name.isidentifier()):
+        return "your function"
+    return f"your {name}" if yours else name
 
 
 #: numpy modules whose attributes a student's function must leave alone, besides every
@@ -74,73 +69,37 @@ def _restore(before: dict[types.ModuleType, dict[str, object]]) -> list[str]:
 
 _MISSING = object()
 
+#: How many calls of :func:`call` are running now (in any thread).
+_depth = 0
 
-def _run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str, object]:
-    """``function(*args)`` stopped after ``limit`` s by SIGALRM (main thread only)."""
-    state = {"armed": True, "fired": False}
 
-    def on_alarm(signum: int, frame: object) -> None:
-        if state["armed"]:
-            state["fired"] = True
-            raise _TimeIsUp
+def inside_call() -> bool:
+    """Whether a :func:`call` is running, which reports its function's errors itself."""
+    return _depth > 0
 
-    machinery_function(on_alarm)
-    previous = signal.signal(signal.SIGALRM, on_alarm)
-    outer_delay, outer_interval = signal.setitimer(signal.ITIMER_REAL, limit)
-    start = time.monotonic()
+
+def reported(error: BaseException, name: str) -> StudentCodeError:
+    """The one-line StudentCodeError of :func:`call` for ``error``, raised by ``name``."""
+    return _raised(error, name, "", None, "", "", "run this cell again")
+
+
+def _working_folder() -> str | None:
     try:
-        outcome: tuple[str, object] = ("returned", function(*args))
-    except _TimeIsUp as error:
-        outcome = ("timeout", error)
-    except BaseException as error:  # reported to the student, not hidden
-        outcome = ("raised", error)
-    finally:
-        state["armed"] = False
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, signal.SIG_DFL if previous is None else previous)
-        if outer_delay:  # an outer timer (e.g. pytest-timeout's) runs on, a little late
-            remaining = max(outer_delay - (time.monotonic() - start), 1e-3)
-            signal.setitimer(signal.ITIMER_REAL, remaining, outer_interval)
-    if state["fired"] and outcome[0] != "timeout":   # swallowed by a bare `except:`
-        outcome = ("timeout", outcome[1] if outcome[0] == "raised" else None)
-    return outcome
+        return os.getcwd()
+    except OSError:  # the working folder was deleted
+        return None
 
 
-def _run_in_thread(function: Callable, args: tuple, limit: float) -> tuple[str, object]:
-    """``function(*args)`` in a worker thread; after ``limit`` s it is sent :class:`_TimeIsUp`."""
-    box: dict[str, tuple[str, object]] = {}
-
-    def target() -> None:
-        try:
-            box["outcome"] = ("returned", function(*args))
-        except _TimeIsUp as error:
-            box["outcome"] = ("timeout", error)
-        except BaseException as error:  # reported to the student
-            box["outcome"] = ("raised", error)
-
-    worker = threading.Thread(target=target, name="student code", daemon=True)
-    worker.start()
+def _restore_working_folder(before: str | None) -> str | None:
+    """Go back to the working folder ``before`` if the call left it; the folder it left."""
+    now = _working_folder()
+    if before is None or now == before:
+        return None
     try:
-        worker.join(limit)
-    except KeyboardInterrupt:  # the kernel was interrupted while waiting
-        _stop_thread(worker, KeyboardInterrupt)
-        worker.join(1.0)
-        return box.get("outcome", ("raised", KeyboardInterrupt()))
-    if worker.is_alive():
-        _stop_thread(worker, _TimeIsUp)
-        worker.join(1.0)
-        outcome = box.get("outcome")
-        return ("timeout", outcome[1] if outcome and outcome[0] != "returned" else None)
-    return box["outcome"]
-
-
-def _stop_thread(worker: threading.Thread, kind: type[BaseException]) -> None:
-    """Raise ``kind`` inside ``worker`` at its next line of Python (CPython only)."""
-    try:
-        ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(worker.ident),
-                                                   ctypes.py_object(kind))
-    except (AttributeError, TypeError):  # not CPython: the thread runs on in the background
+        os.chdir(before)
+    except OSError:  # deleted meanwhile: nothing to go back to
         pass
+    return now or "a folder that no longer exists"
 
 
 class _Tripped(BaseException):
@@ -243,7 +202,7 @@ def pack_name(frame: types.FrameType) -> str:
 #: Code of the pack that runs around a student's function, not as its answer: modules
 #: whose every function is such machinery, and single functions registered by
 #: :func:`machinery_function` (the time limit's signal handler, a stand-in, a recorder).
-MACHINERY_MODULES = ("guards.py",)
+MACHINERY_MODULES = ("guards.py", "running.py")
 _MACHINERY_CODES: set[types.CodeType] = set()
 
 
@@ -274,20 +233,22 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
          time_limit: float | None = None, arg_names: Sequence[str] | None = None,
          hint: str = "", shape_hint: str = "", rerun: str = "run this check again",
          forbid: Sequence[Callable] = (), forbid_pack: bool = False,
-         allow: Sequence[Callable] = ()) -> object:
+         allow: Sequence[Callable] = (),
+         failure: type[StudentCodeError] = StudentCodeError) -> object:
     """Call a student's function on copies of ``args`` under a time limit.
 
     Array arguments are copied, so the student's function cannot change the caller's
     data. The function runs for at most ``time_limit`` seconds: in the main thread where
-    the system has ``SIGALRM`` (Linux, macOS: a Jupyter kernel, pytest) a timer raises an
-    exception inside it that its own ``except Exception`` cannot swallow, and the previous
-    SIGALRM handler and timer are restored afterwards (an outer timer is re-armed with its
-    remaining time, late by at most this call's duration). Elsewhere (off the main thread,
-    or on Windows) the function runs in a worker thread that is sent the same exception
-    after ``time_limit`` seconds; a thread stuck inside one long C call (a huge numpy
-    operation, ``time.sleep``) is then left to finish in the background while this call
-    reports the time-out. Either way only Python code is interrupted: a single numpy call
-    runs to its end.
+    the system has ``SIGALRM`` (Linux, macOS: a Jupyter kernel, pytest) a timer stops it,
+    and the previous SIGALRM handler and timer are restored afterwards (an outer timer is
+    re-armed with its remaining time, late by at most this call's duration). Elsewhere
+    (off the main thread, or on Windows) the function runs in a worker thread that is
+    stopped the same way; a thread stuck inside one long C call (a huge numpy operation,
+    ``time.sleep``) is then left to finish in the background while this call reports the
+    time-out. Either way the stop is raised again at every line the function runs until it
+    has ended, so not even a bare ``except:`` inside a loop outlasts it
+    (:mod:`~lqe_helpers.student_code.running`); only Python code is stopped: a single numpy
+    call runs to its end.
 
     These guard against a student's mistakes, not against deliberate cheating: code in the
     same process that switches the timer off or reads the caller's frames is not stopped.
@@ -322,11 +283,17 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     allow : sequence of callables
         With ``forbid_pack``: the pack's functions (and what they call) that the task's text
         lets the student use.
+    failure : subclass of StudentCodeError
+        What a failure other than :class:`NotWrittenYet` and :class:`TimedOut` raises: a
+        check passes :class:`~lqe_helpers.student_code.errors.CheckFailed`.
 
     Returns
     -------
     object
         What the function returned, unchecked (see :func:`result_array`).
+
+    Warnings the function gives (numpy's "overflow encountered", say) are not printed: a
+    failure's message quotes them; a call that returns drops them.
 
     Raises
     ------
@@ -336,68 +303,96 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         If ``function`` is not callable, raised any other exception (including
         ``SystemExit`` and ``KeyboardInterrupt``), did not return within the limit,
         changed an input in place (with ``arg_names``), replaced a function of the pack
-        or of numpy (restored first), ran a function of ``forbid``, or is an ``async``
-        function. One line: the type,
+        or of numpy (restored first), changed the working folder (changed back first),
+        ran a function of ``forbid``, or is an ``async`` function. One line: the type,
         message and the line of the student's own code where it happened.
     """
     name = name or function_name(function)
     on = f", on {where}" if where else ""
     if not callable(function):
-        raise StudentCodeError(
+        raise failure(
             f"{name} must be a function (its name, without parentheses), got a "
             f"{type(function).__name__}")
     time_limit = TIME_LIMIT if time_limit is None else time_limit
     if not (isinstance(time_limit, (int, float)) and 0 < time_limit < float("inf")):
         raise ValueError(f"time_limit must be a number of seconds > 0, got {time_limit!r}")
     copies = tuple(_copy(arg) for arg in args)
-    before = _snapshot()
+    before, folder = _snapshot(), _working_folder()
     alarm = hasattr(signal, "setitimer") and threading.current_thread() is threading.main_thread()
-    run = _run_with_alarm if alarm else _run_in_thread
+    run = run_with_alarm if alarm else run_in_thread
     watch = _Watch(forbid, pack=forbid_pack, allow=allow)
-    kind, value = run(watch.wrap(function), copies, float(time_limit))
+    global _depth
+    _depth += 1
+    try:
+        # Recorded, not printed (the filters in force still apply: "error" still raises).
+        with warnings.catch_warnings(record=True) as warned:
+            kind, value = run(watch.wrap(function), copies, float(time_limit))
+    finally:
+        _depth -= 1
     replaced = _restore(before)
+    moved = _restore_working_folder(folder)
     if watch.tripped:
-        raise StudentCodeError(
+        raise failure(
             f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "
             f"yourself, from the equation, with NumPy (@, np.linalg), not to call the pack's "
             f"solution")
     if kind == "timeout":
         error = value if isinstance(value, BaseException) else None
-        failure = TimedOut(
+        stopped = TimedOut(
             f"{name} did not return within {time_limit:g} s"
             f"{location(error.__traceback__) if error else ''}{on}: is there a loop that "
             f"never ends (a while loop whose condition never turns false), or one over far "
             f"more steps than its input has?")
-        failure.student_traceback = error.__traceback__ if error else None
-        raise failure
+        stopped.student_traceback = error.__traceback__ if error else None
+        raise stopped
     if kind == "raised":
         assert isinstance(value, BaseException)
-        raise _raised(value, name, on, arg_names, hint, shape_hint, rerun)
+        hint = " ".join(part for part in (hint, _warnings_text(warned)) if part)
+        raise _raised(value, name, on, arg_names, hint, shape_hint, rerun, failure)
+    if moved:
+        raise failure(
+            f"{name} changed the working folder (os.chdir) to {moved} (now changed back){on}: "
+            f"a function must compute its result, not move the notebook to another folder")
     if replaced:
-        raise StudentCodeError(
+        raise failure(
             f"{name} replaced {', '.join(replaced[:3])}{' …' * (len(replaced) > 3)} (now "
             f"restored){on}: a function must compute its result, not change the pack's or "
             f"numpy's code")
     if inspect.iscoroutine(value):
         value.close()
-        raise StudentCodeError(f"{name} is an async function (async def); write it with a "
+        raise failure(f"{name} is an async function (async def); write it with a "
                                f"plain def")
     if arg_names is not None:
         for label, given, original in zip(arg_names, copies, args, strict=False):
             if isinstance(original, np.ndarray) and not np.array_equal(
                     given, original, equal_nan=original.dtype.kind in "fc"):
-                raise StudentCodeError(
+                raise failure(
                     f"{name} changed its input {label} in place{on}. A function must leave "
                     f"its inputs unchanged: work on new arrays instead of modifying {label} "
                     f"(e.g. with += or an assignment to {label}[...])")
     return value
 
 
+def _warnings_text(warned: list[warnings.WarningMessage]) -> str:
+    """What the warnings a student's function gave say, for its failure's message."""
+    said = list(dict.fromkeys(f"{type(item.message).__name__}: {error_text(item.message)}"
+                              for item in warned))
+    if not said:
+        return ""
+    more = f" and {len(said) - 2} more" if len(said) > 2 else ""
+    return f"Before that it warned: {'; '.join(said[:2])}{more}."
+
+
 def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] | None,
-            hint: str, shape_hint: str, rerun: str) -> StudentCodeError:
-    """The StudentCodeError reporting ``error``, raised by the student's function."""
-    if isinstance(error, StudentCodeError):  # already one line for the student (a stand-in's)
-        return error
+            hint: str, shape_hint: str, rerun: str,
+            failure: type[StudentCodeError] = StudentCodeError) -> StudentCodeError:
+    """The ``failure`` reporting ``error``, raised by the student's function."""
+    if isinstance(error, (failure, NotWrittenYet, TimedOut)):
+        return error                      # already one line for the student
+    if isinstance(error, StudentCodeError):  # a stand-in's or a guard's: its line, as failure
+        reported = failure(str(error))
+        reported.student_traceback = error.student_traceback or error.__traceback__
+        return reported
     if isinstance(error, NotImplementedError):
         return NotWrittenYet(
             f"{name} is not written yet: {NOT_WRITTEN_ADVICE.format(rerun=rerun)}")
@@ -420,7 +415,7 @@ def _raised(error: BaseException, name: str, on: str, arg_names: Sequence[str] |
     else:
         said = f": {text}" if text else ""
         message = f"{name} raised {kind}{said}{at}{on}.{extra}"
-    failure = StudentCodeError(message)
-    failure.student_traceback = error.__traceback__
-    return failure
+    reported = failure(message)
+    reported.student_traceback = error.__traceback__
+    return reported
 

@@ -5,12 +5,15 @@ from __future__ import annotations
 import functools
 import linecache
 import os
+import re
 import site
 import sys
 import sysconfig
 import traceback
 import types
 from pathlib import Path
+
+import numpy as np
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -49,16 +52,26 @@ class StudentCodeError(OwnCodeTraceback, Exception):
     """A student's function failed, hung or returned something unusable.
 
     Its message is one line, written for the student (what went wrong and where), with
-    no library code in it. Checks turn it into a failed check; explorers show it in
-    their numbers line instead of a picture.
+    no library code in it. Explorers show it in their numbers line instead of a picture.
+    The pack's one hierarchy of errors for students: checks raise its subclass
+    :class:`CheckFailed` (``student_code.call(..., failure=CheckFailed)``).
     """
 
 
-class NotWrittenYet(StudentCodeError):
+class CheckFailed(StudentCodeError, AssertionError):
+    """A task's answer is not right yet; the message says what is wrong.
+
+    An ``AssertionError``, so "Run All" stops at the wrong step. In Jupyter it shows the
+    student's own cells and the message only (:class:`OwnCodeTraceback`). Every check of
+    :mod:`lqe_helpers.checks` raises it (``checks.machinery`` re-exports it).
+    """
+
+
+class NotWrittenYet(CheckFailed):
     """The student's function still raises ``NotImplementedError`` (the stub)."""
 
 
-class TimedOut(StudentCodeError):
+class TimedOut(CheckFailed):
     """The student's function did not return within its time limit (and was stopped)."""
 
 
@@ -87,14 +100,16 @@ def brief_errors() -> None:
     task_runs.watch_task_cells(shell)
 
     def handler(self, etype, value, tb, tb_offset=None):  # IPython's CustomTB signature
-        if issubclass(etype, NameError):
-            message = task_runs.missing_name_message(value, tb)
-            if message is not None:
-                stb = [f"NameError: {message}"]
-                self._showtraceback(etype, value, stb)
-                return stb
-            stb = self.InteractiveTB.structured_traceback(etype, value, tb,
-                                                          tb_offset=tb_offset)
+        advice = read_only_advice(value, tb)
+        if advice is not None:
+            etype, value = ValueError, ValueError(advice)
+            stb = self.InteractiveTB.structured_traceback(etype, value, own_frames(tb),
+                                                          tb_offset=0)
+        elif issubclass(etype, NameError) and (
+                message := task_runs.missing_name_message(value, tb)) is not None:
+            stb = [f"NameError: {message}"]
+            self._showtraceback(etype, value, stb)
+            return stb
         elif _raised_by_the_pack(tb):
             stb = self.InteractiveTB.structured_traceback(etype, value, own_frames(tb),
                                                           tb_offset=0)
@@ -105,6 +120,43 @@ def brief_errors() -> None:
         return stb
 
     shell.set_custom_exc((ValueError, TypeError, NameError), handler)
+
+
+#: The target of an assignment that changes an array in place: ``P += Q``, ``P[0] = 1``.
+_IN_PLACE = re.compile(r"^\s*([A-Za-z_]\w*)\s*(?:\[.*\])?\s*(?:[-+*/@%&|^]|//|\*\*)?=(?!=)")
+
+
+def read_only_advice(error: BaseException, tb: types.TracebackType | None) -> str | None:
+    """For numpy's "assignment destination is read-only" in the student's own line, what to do.
+
+    "P_close is read-only: copy it (P = P_close.copy()) before changing P in place" when
+    the line changes ``P`` in place and ``P`` is the array ``P_close`` of the pack's results
+    (or a view of it); None for any other error.
+    """
+    text = error_text(error)
+    if not isinstance(error, ValueError) or "read-only" not in text:
+        return None
+    last = None
+    while tb is not None:
+        last, tb = tb, tb.tb_next
+    if last is None or not is_own_code(last.tb_frame.f_code.co_filename):
+        return None
+    frame = last.tb_frame
+    match = _IN_PLACE.match(linecache.getline(frame.f_code.co_filename, last.tb_lineno))
+    if match is None:
+        return None
+    target = match.group(1)
+    array = frame.f_locals.get(target, frame.f_globals.get(target))
+    names = {name: value for name, value in {**frame.f_globals, **frame.f_locals}.items()
+             if name != target and not name.startswith("_") and isinstance(value, np.ndarray)}
+    source = next((name for name, value in names.items() if value is array), None) or next(
+        (name for name, value in names.items() if isinstance(array, np.ndarray)
+         and np.may_share_memory(value, array)), None)
+    if source is None:
+        return (f"{target} is read-only (the pack's results cannot be changed): copy it "
+                f"({target} = {target}.copy()) before changing {target} in place")
+    return (f"{source} is read-only: copy it ({target} = {source}.copy()) before changing "
+            f"{target} in place")
 
 
 def _raised_by_the_pack(tb: types.TracebackType | None) -> bool:

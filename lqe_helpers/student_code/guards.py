@@ -15,6 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
+from . import calling
 from .errors import StudentCodeError
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
@@ -127,7 +128,10 @@ def guarded(name: str, function: Callable) -> Callable:
     """``function`` with the inputs guard of ``name`` (:data:`GUARDS`), if it has one.
 
     The wrapper calls the student's function unchanged when the inputs fit; otherwise it
-    raises :class:`StudentCodeError`: "my_filter was given R of shape (2, 2); …".
+    raises :class:`StudentCodeError`: "my_filter was given R of shape (2, 2); …". Called
+    from a notebook cell (not through :func:`~lqe_helpers.student_code.call`), an error of
+    the function is reported the same way, as one line and the student's own frames (not
+    this wrapper's source).
     """
     guard = GUARDS.get(name)
     if guard is None:
@@ -141,6 +145,11 @@ def guarded(name: str, function: Callable) -> Callable:
             problem = None
         if problem is not None:
             raise StudentCodeError(f"{name} was given inputs that do not fit: {problem}")
-        return function(*args, **kwargs)
+        if calling.inside_call():  # a check's or an explorer's call reports an error itself
+            return function(*args, **kwargs)
+        try:
+            return function(*args, **kwargs)
+        except Exception as error:  # called from the student's cell: their lines, one line
+            raise calling.reported(error, name) from None
 
     return checked

@@ -33,13 +33,32 @@ SAVED_BY = {"my_filter": "notebook 01 (the check after Task 1)",
             "compensate": "notebook 05 (the check after Task 1)"}
 
 
+#: The absolute folder that :func:`save` and :func:`load` use by default, fixed by the first
+#: of them in this session (the kernel's working folder then: the notebook's folder).
+_home: Path | None = None
+
+
+def save_folder() -> Path:
+    """The absolute path of :data:`SAVE_FOLDER` for this session.
+
+    Fixed the first time it is asked for (by the first :func:`save` or :func:`load`), from
+    the working folder at that moment, so that a later ``os.chdir`` (in a student's cell)
+    cannot send a saved function elsewhere.
+    """
+    global _home
+    if _home is None:
+        _home = Path(os.path.abspath(SAVE_FOLDER))
+    return _home
+
+
 def _folder(folder: str | os.PathLike | None) -> Path:
-    return Path.cwd() / SAVE_FOLDER if folder is None else Path(folder)
+    return save_folder() if folder is None else Path(os.path.abspath(folder))
 
 
 def _shown(path: Path) -> str:
+    """``path`` as a message shows it: from the notebook's folder when it is inside it."""
     try:
-        return path.relative_to(Path.cwd()).as_posix()
+        return path.relative_to(save_folder().parent).as_posix()
     except ValueError:
         return str(path)
 
@@ -79,8 +98,8 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
         arguments, numpy as ``np`` and Python's built-ins only (the later notebook
         does not have the others).
     folder : path, optional
-        Where to write; default :data:`SAVE_FOLDER` in the working folder (in Jupyter,
-        the notebook's folder).
+        Where to write; default :data:`SAVE_FOLDER` in the working folder of the first save
+        or load of this session (in Jupyter, the notebook's folder): :func:`save_folder`.
 
     Returns
     -------
@@ -179,7 +198,7 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     name : str
         The function's name, e.g. ``"my_filter"``.
     folder : path, optional
-        Where the file is; default :data:`SAVE_FOLDER` in the working folder.
+        Where the file is; default :func:`save_folder`.
 
     Returns
     -------
@@ -203,6 +222,12 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
         raise ValueError(f"name must be a function's name, e.g. 'my_filter', got {name!r}")
     path = _folder(folder) / f"{name}.py"
     shown = _shown(path)
+    if path.exists() and not path.is_file():
+        kind = "a folder" if path.is_dir() else "not a plain file"
+        raise StudentCodeError(
+            f"{shown} is {kind}, so {name} cannot be loaded from it: rename or delete it, run "
+            f"the task of {SAVED_BY.get(name, 'the notebook that saves it')} again, then this "
+            f"cell")
     if not path.is_file():
         writer = SAVED_BY.get(name, f"the notebook whose task defines {name}")
         message = (f"{name} is not saved yet: {shown} does not exist. {writer} writes it when "

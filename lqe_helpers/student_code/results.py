@@ -132,8 +132,8 @@ def array_problem(value: object, *, shape: Sequence[int | None] | None = None,
 
 def result_array(value: object, *, name: str, what: str,
                  shape: Sequence[int | None] | None = None, allow_nan: bool = False,
-                 double: bool = False,
-                 where: str = "") -> np.ndarray:
+                 double: bool = False, where: str = "",
+                 failure: type[StudentCodeError] = StudentCodeError) -> np.ndarray:
     """What a student's function returned, as a float array, or a StudentCodeError.
 
     Parameters
@@ -148,6 +148,8 @@ def result_array(value: object, *, name: str, what: str,
         See :func:`array_problem`.
     where : str
         What it was called on, for the message.
+    failure : subclass of StudentCodeError
+        What it raises (a check passes ``CheckFailed``).
 
     Returns
     -------
@@ -157,11 +159,11 @@ def result_array(value: object, *, name: str, what: str,
     Raises
     ------
     StudentCodeError
-        One line naming what was returned (:func:`array_problem`).
+        (``failure``) One line naming what was returned (:func:`array_problem`).
     """
     problem = array_problem(value, shape=shape, allow_nan=allow_nan, double=double)
     if problem is not None:
         on = f" (on {where})" if where else ""
-        raise StudentCodeError(f"{name} returned {problem}; it must return {what}{on}")
+        raise failure(f"{name} returned {problem}; it must return {what}{on}")
     return np.asarray(value, dtype=float)
 
