@@ -185,7 +185,21 @@ def test_every_function_task_is_called_with_its_allowlist() -> None:
 
 #: The only pack functions a student's function may run: the wrappers around it.
 MACHINERY = {
-    "lqe_helpers.student_code.calling._run_with_alarm.<locals>.on_alarm",
+    # running.py: the time limit's signal handler and the hooks that stop the function
+    "lqe_helpers.student_code.running._Stopper.__init__",
+    "lqe_helpers.student_code.running._Stopper.end",
+    "lqe_helpers.student_code.running._Stopper.mark",
+    "lqe_helpers.student_code.running._Stopper.profile",
+    "lqe_helpers.student_code.running._Stopper.stop",
+    "lqe_helpers.student_code.running._Stopper.trace",
+    "lqe_helpers.student_code.running._Stopper.trace_stack",
+    "lqe_helpers.student_code.running._send",
+    "lqe_helpers.student_code.running.run_in_thread",
+    "lqe_helpers.student_code.running.run_with_alarm",
+    # calling.py: what guards.py asks while it reports a loaded function's error
+    "lqe_helpers.student_code.calling.inside_call",
+    "lqe_helpers.student_code.calling.reported",
+    "lqe_helpers.student_code.guards._readings_problem",
     "lqe_helpers.student_code.keeping._not_saved_yet.<locals>.stand_in",
     "lqe_helpers.student_code.task_runs.recorded.<locals>.recording",
     "lqe_helpers.student_code.task_runs.note_call",

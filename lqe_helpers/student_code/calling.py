@@ -73,11 +73,39 @@ _MISSING = object()
 _depth = 0
 
 
+#: Code of the pack that runs around a student's function, not as its answer: modules
+#: whose every function is such machinery, and single functions registered by
+#: :func:`machinery_function` (the time limit's signal handler, a stand-in, a recorder).
+MACHINERY_MODULES = ("guards.py", "running.py")
+_MACHINERY_CODES: set[types.CodeType] = set()
+
+
+def machinery_function(function: Callable) -> Callable:
+    """Mark ``function`` (of the pack) as machinery a student's function may run through.
+
+    Its own code, not what it wraps (a wrapper's ``__wrapped__`` is the student's function).
+    """
+    _MACHINERY_CODES.add(function.__code__)  # type: ignore[attr-defined]
+    return function
+
+
+def machinery(code: types.CodeType) -> bool:
+    """Whether ``code`` is machinery of :data:`MACHINERY_MODULES` or :func:`machinery_function`."""
+    return code in _MACHINERY_CODES or (
+        os.path.basename(code.co_filename) in MACHINERY_MODULES
+        and os.path.dirname(os.path.realpath(code.co_filename)) == _HERE)
+
+
+_HERE = os.path.dirname(os.path.realpath(__file__))
+
+
+@machinery_function
 def inside_call() -> bool:
     """Whether a :func:`call` is running, which reports its function's errors itself."""
     return _depth > 0
 
 
+@machinery_function
 def reported(error: BaseException, name: str) -> StudentCodeError:
     """The one-line StudentCodeError of :func:`call` for ``error``, raised by ``name``."""
     return _raised(error, name, "", None, "", "", "run this cell again")
@@ -199,30 +227,6 @@ def pack_name(frame: types.FrameType) -> str:
     return f"{module}.{frame.f_code.co_qualname}"
 
 
-#: Code of the pack that runs around a student's function, not as its answer: modules
-#: whose every function is such machinery, and single functions registered by
-#: :func:`machinery_function` (the time limit's signal handler, a stand-in, a recorder).
-MACHINERY_MODULES = ("guards.py", "running.py")
-_MACHINERY_CODES: set[types.CodeType] = set()
-
-
-def machinery_function(function: Callable) -> Callable:
-    """Mark ``function`` (of the pack) as machinery a student's function may run through.
-
-    Its own code, not what it wraps (a wrapper's ``__wrapped__`` is the student's function).
-    """
-    _MACHINERY_CODES.add(function.__code__)  # type: ignore[attr-defined]
-    return function
-
-
-def machinery(code: types.CodeType) -> bool:
-    """Whether ``code`` is machinery of :data:`MACHINERY_MODULES` or :func:`machinery_function`."""
-    return code in _MACHINERY_CODES or (
-        os.path.basename(code.co_filename) in MACHINERY_MODULES
-        and os.path.dirname(os.path.realpath(code.co_filename)) == _HERE)
-
-
-_HERE = os.path.dirname(os.path.realpath(__file__))
 
 
 def _copy(value: object) -> object:
