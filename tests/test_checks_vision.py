@@ -365,7 +365,7 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
     ("estimates only", "vision_trial(1.5) must return two things, the readings y and the "
                        "estimates"),
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),
-    ("engine", "vision_trial runs the pack's own lqe_helpers.filter.kalman_filter"),
+    ("engine", "vision_trial runs the pack's own lqe_helpers._engine.filter_run"),
 ])
 def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_trial, task2(slip))
