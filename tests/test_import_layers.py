@@ -34,8 +34,7 @@ ALLOWED = {
     "checks": {"science", "drawing", "experiments", "checks"},
     "authoring": set(LAYERS),
 }
-#: Longest module allowed (lines). The instructor tools (lqe_helpers/authoring) are split
-#: by their own part of issue 18 and are not counted here.
+#: Longest module allowed (lines), in every layer (the instructor's tools too).
 MAX_LINES = 500
 
 
@@ -181,8 +180,7 @@ def test_imports_run_down_the_layers_and_no_private_name_crosses_a_module(module
 
 def test_no_module_is_longer_than_the_limit() -> None:
     long = {module: length for module, path in sources()
-            if layer_of(module) != "authoring"
-            and (length := len(path.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
+            if (length := len(path.read_text(encoding="utf-8").splitlines())) > MAX_LINES}
     assert long == {}
 
 
