@@ -401,3 +401,29 @@ def test_bad_input_messages(call, message: str) -> None:
 def test_bad_input_is_rejected_by_name(call, name: str) -> None:
     with pytest.raises(ValueError, match=name):
         call()
+
+
+@pytest.mark.slow
+def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
+    """``run.learning_figure(mc)`` draws what six arrays drew, pixel for pixel."""
+    import matplotlib.pyplot as plt
+
+    from lqe_helpers import figures, plotting
+
+    b_true = bias_model.DEFAULT_BIAS
+    run = bias_model.track_with_input(DEFAULT, bias=b_true)
+    mc = bias_model.track_with_input(DEFAULT, bias=b_true, runs=20)
+    rms = np.sqrt(np.mean((mc.bias_estimates - b_true) ** 2, axis=0))   # by hand
+    np.testing.assert_array_equal(mc.bias_rms_error(), rms)
+    by_arrays = figures.bias_learning_figure(DEFAULT.times, run.bias_estimates, run.bias_stds,
+                                             b_true, rms, mc.bias_stds[0])
+    by_object = run.learning_figure(mc)
+    try:
+        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
+    finally:
+        plt.close(by_arrays)
+        plt.close(by_object)
+    other = bias_model.track_with_input(DEFAULT, bias=b_true + 1.0, runs=3)
+    for wrong_run, runs in ((mc, mc), (run, run), (run, other), (run, "mc")):
+        with pytest.raises(ValueError, match=r"single run|runs must be"):
+            wrong_run.learning_figure(runs)

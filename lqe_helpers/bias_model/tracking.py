@@ -15,6 +15,7 @@ Each public function checks its inputs once, at its entry.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -35,6 +36,9 @@ from .equations import (
     true_states,
     unit_noise,
 )
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 #: The filter's prior standard deviation of the bias (cm/s²): the observer allows
 #: offsets up to about half the peak acceleration before it has seen anything.
@@ -125,6 +129,44 @@ class InputTracking:
     def mse(self) -> np.ndarray:
         """Per-run MSE (cm²) of the filtered position after the burn-in, shape (...)."""
         return metrics.mse(self.positions, self.truth[:, 0], self.scenario.burn_in_steps)
+
+    def bias_rms_error(self) -> np.ndarray:
+        """Root-mean-square error of b̂ over the runs (axis 0) against time (cm/s²), (..., n)."""
+        return np.sqrt(np.mean((self.bias_estimates - self.bias) ** 2, axis=0))
+
+    def learning_figure(self, runs: InputTracking) -> Figure:
+        """Notebook 06's Figure 1: this run's b̂ with its band, and the runs' error of b̂.
+
+        Built by :func:`lqe_helpers.figures.bias_learning_figure`, so a notebook passes
+        two results instead of six arrays.
+
+        Parameters
+        ----------
+        runs : InputTracking
+            Monte Carlo runs (one leading axis) of the same scenario, bias and σ's:
+            their RMS error of b̂ (:meth:`bias_rms_error`) and the filter's own σ of it.
+
+        Raises
+        ------
+        ValueError
+            If this tracking is not a single run, or ``runs`` is not a batch of runs of
+            the same experiment.
+        """
+        from .. import figures
+
+        if self.bias_estimates.ndim != 1:
+            raise ValueError(f"learning_figure draws a single run: this tracking has leading "
+                             f"axes {self.bias_estimates.shape[:-1]}")
+        if not (isinstance(runs, InputTracking) and runs.bias_estimates.ndim == 2
+                and (runs.scenario, runs.bias, runs.sigma_a, runs.sigma_v)
+                == (self.scenario, self.bias, self.sigma_a, self.sigma_v)):
+            raise ValueError(
+                "runs must be an InputTracking of Monte Carlo runs (one leading axis) of "
+                "this run's scenario, bias, sigma_a and sigma_v, got "
+                f"{type(runs).__name__}")
+        return figures.bias_learning_figure(self.scenario.times, self.bias_estimates,
+                                            self.bias_stds, self.bias, runs.bias_rms_error(),
+                                            runs.bias_stds[0])
 
     def dead_reckoning_mse(self) -> np.ndarray:
         """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
