@@ -1,9 +1,9 @@
-"""One drawing function per picture: the notebooks' and the explorers' trial of 03 and 04.
+"""One drawing function per picture: the notebooks' and the explorers' trial (03, 04, 05).
 
 A trial's signals over its errors are drawn by :func:`lqe_helpers.figures.common.trial_column`
 only: the notebooks' figure (``tracking_comparison_figure``, ``fusion_trial_figure``,
-``Tracking.figure``) calls it with data, the explorers of 03 and 04 call it once with no
-data and then refill its lines.
+``Tracking.figure``) calls it with data, the explorers of 03, 04 and 05 call it once with
+no data and then refill its lines.
 """
 
 from __future__ import annotations
@@ -12,7 +12,7 @@ import matplotlib.pyplot as plt
 import pytest
 
 from lqe_helpers import experiments
-from lqe_helpers.explorers import fusion, noisier_proprioception
+from lqe_helpers.explorers import delay, fusion, noisier_proprioception
 from lqe_helpers.figures import common
 from lqe_helpers.scenario import DEFAULT
 
@@ -30,6 +30,7 @@ def painted(monkeypatch) -> list[dict]:
     monkeypatch.setattr(common, "trial_column", recording)
     import lqe_helpers.explorers.common as explorer_common
     monkeypatch.setattr(explorer_common, "trial_column", recording)
+    monkeypatch.setattr(delay, "trial_column", recording)
     return calls
 
 
@@ -46,7 +47,8 @@ def test_the_notebooks_trial_figure_is_painted_by_trial_column(painted) -> None:
 
 
 @pytest.mark.parametrize("factory", [fusion.explore_fusion,
-                                     noisier_proprioception.explore_noisier_proprioception])
+                                     noisier_proprioception.explore_noisier_proprioception,
+                                     delay.explore_delay])
 def test_the_explorers_trial_is_painted_by_the_same_function(painted, factory) -> None:
     explorer = factory()
     assert len(painted) == 1

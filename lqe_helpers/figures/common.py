@@ -2,7 +2,7 @@
 
 The figures: :func:`tracking_comparison_figure` (estimates beside the truth, their errors
 below; notebooks 01, 03, 04, 05; its painter :func:`trial_column` draws the explorers'
-trials of 03 and 04 too) and :func:`paired_mse_figure` (one point per Monte
+trials of 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
 Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 (:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
@@ -184,9 +184,10 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
     """Draw one trial's signals over its errors: the one painter of that picture.
 
     Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 and
-    :meth:`lqe_helpers.experiments.Tracking.figure`) and by the explorers of 03 and 04
-    (:func:`lqe_helpers.explorers.common.build_trial_panels`), which draw with no data and
-    then refill these lines on every slider move.
+    :meth:`lqe_helpers.experiments.Tracking.figure`) and by the explorers of 03, 04 and 05
+    (:func:`lqe_helpers.explorers.common.build_trial_panels`,
+    :func:`lqe_helpers.explorers.delay.draw_delay`), which draw with no data and then
+    refill these lines on every slider move.
 
     Parameters
     ----------
