@@ -217,7 +217,7 @@ class UnbiasedRun:
         """The run of :func:`track_with_input` at true bias ``bias`` (cm/s², any sign).
 
         Equal to the filter run on the biased signal to rounding (1e-9,
-        ``tests/test_bias_model.py``); dead reckoning integrates the biased signal.
+        ``tests/bias_model/test_bias_model.py``); dead reckoning integrates the biased signal.
 
         Raises
         ------
