@@ -15,12 +15,12 @@ Each public function checks its inputs once, at its entry; what it calls inside
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import _matrices, metrics, model, simulation, validation
+from . import _engine, _matrices, metrics, model, simulation, validation
 from .filter import FilterResult, kalman_filter
 from .prediction import predict_ahead
 from .scenario import Scenario
@@ -37,8 +37,8 @@ COMPARISON_ROLES = ("alternative", "reference")
 class FilterModel:
     """The model a filter assumes: what :func:`~lqe_helpers.filter.kalman_filter` takes.
 
-    Built by :func:`filter_model` (the butterfly, Tutorial eqs. (1)–(6)) or
-    :func:`lqe_helpers.bias_model.filter_model` (a known input, Lesson 0.5 eqs. (4)–(9)).
+    Built by :func:`filter_model` (the butterfly, Tutorial eqs. (1)–(6)), and inside
+    :func:`lqe_helpers.bias_model.unbiased_run` (a known input, Lesson 0.5 eqs. (4)–(9)).
     Its arrays are read-only: one model may serve many runs.
 
     Attributes
@@ -57,6 +57,12 @@ class FilterModel:
         Initial covariance; leading axes sweep P0.
     B : ndarray, shape (k, p), or None
         Input matrix, for a filter driven by a known input.
+
+    :meth:`filter` checks the readings it is given (and the model) through
+    :func:`~lqe_helpers.filter.kalman_filter`. :meth:`steady_state` of a model made by
+    :func:`filter_model` (which checked its inputs) runs the engine's core directly; of
+    one made by hand (or changed with :func:`dataclasses.replace`), the checked
+    :func:`~lqe_helpers.steady_state.steady_state`.
     """
 
     A: np.ndarray
@@ -66,14 +72,17 @@ class FilterModel:
     z0: np.ndarray
     P0: np.ndarray
     B: np.ndarray | None = None
+    #: True only for a model :func:`filter_model` built from checked inputs (not an
+    #: argument, so neither a caller nor :func:`dataclasses.replace` can set it).
+    _checked: bool = field(default=False, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
-        for field in fields(self):
-            value = getattr(self, field.name)
+        for name in ("A", "C", "Q", "R", "z0", "P0", "B"):
+            value = getattr(self, name)
             if value is not None:
                 array = np.array(value, dtype=float)
                 array.flags.writeable = False
-                object.__setattr__(self, field.name, array)
+                object.__setattr__(self, name, array)
 
     def filter(self, y: np.ndarray, u: np.ndarray | None = None) -> FilterResult:
         """:func:`~lqe_helpers.filter.kalman_filter` of ``y`` (..., n, m) with this model.
@@ -84,7 +93,13 @@ class FilterModel:
                              B=self.B, u=u)
 
     def steady_state(self) -> SteadyState:
-        """The filter's steady state (:func:`~lqe_helpers.steady_state.steady_state`)."""
+        """The filter's steady state (:func:`~lqe_helpers.steady_state.steady_state`).
+
+        Of a model :func:`filter_model` built, the engine's core without a second
+        check of its matrices (an explorer asks for it on every slider move).
+        """
+        if self._checked:
+            return SteadyState(*_engine.riccati(self.A, self.C, self.Q, self.R))
         return steady_state(self.A, self.C, self.Q, self.R)
 
 
@@ -235,11 +250,13 @@ def _sensor_sigmas(name: str, sigmas: object, sensors: tuple[str, ...]) -> np.nd
 def _assemble(scenario: Scenario, sensors: tuple[str, ...], sigmas: np.ndarray,
               p0_variance: np.ndarray) -> FilterModel:
     """The model of :func:`filter_model` from inputs its caller has checked."""
-    return FilterModel(
+    built = FilterModel(
         A=scenario.A, C=_matrices.observation(len(sensors)), Q=scenario.Q,
         R=_matrices.noise_covariance(sigmas), z0=np.asarray(scenario.z0, dtype=float),
         P0=_matrices.scaled_identity(p0_variance, 3),
     )
+    object.__setattr__(built, "_checked", True)
+    return built
 
 
 def filter_model(scenario: Scenario, sensors: Sequence[str] = ("vision",),
@@ -343,9 +360,13 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
         runs, scenario.n_steps, len(sensors))
     noise = validation.shaped_array("noise", noise, expected, ", ".join(sensors))
     noise = noise.reshape(noise.shape[:-2] + (1,) * len(sweep) + noise.shape[-2:])
-    y = simulation.measure(scenario.truth[:, 0], noise, sigmas)
+    # Everything is checked above: the engine's core checks nothing again (R is not
+    # factorised twice), so a slider's σ is checked once on its way to the filter.
+    y = _engine.readings(scenario.truth[:, 0], noise, sigmas)
     filter_ = _assemble(scenario, sensors, assumed, p0)
-    return Tracking(scenario, sensors, y, filter_.filter(y), filter_)
+    result = _engine.filter_run(y, filter_.A, filter_.C, filter_.Q, filter_.R, filter_.z0,
+                                filter_.P0)
+    return Tracking(scenario, sensors, y, result, filter_)
 
 
 @dataclass(frozen=True)

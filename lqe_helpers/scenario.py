@@ -95,7 +95,7 @@ class Scenario:
     #: :attr:`seed`, on purpose: an explorer at its default values then shows another
     #: run than the one a task computes, so it never prints a task's answer (issue 15).
     #: Any seed whose runs do not, by chance, round to a number a task prints
-    #: (``tests/test_explorer_leaks.py`` checks every explorer's default view).
+    #: (``tests/explorers/test_explorer_leaks.py`` checks every explorer's default view).
     explorer_seed: int = 25
     #: Monte Carlo runs behind every "is it better?" answer: enough for 95 %
     #: intervals a few percent wide, fast enough to recompute in a notebook cell.

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import validation
+from . import _engine, validation
 
 
 def sinusoid_states(times: np.ndarray, amplitude: float, frequency: float) -> np.ndarray:
@@ -112,19 +112,7 @@ def measure(positions: np.ndarray, noise: np.ndarray, sigmas: np.ndarray) -> np.
             f"positions (n,), noise (..., n, m) and sigmas (..., m) must agree on n and m, "
             f"got shapes {positions.shape}, {noise.shape} and {sigmas.shape}"
         )
-    shape = np.broadcast_shapes(positions[..., :, None].shape, sigmas[..., None, :].shape,
-                                noise.shape)
-    validation.check_memory(
-        f"positions of shape {positions.shape}, noise of shape {noise.shape} and sigmas of "
-        f"shape {sigmas.shape}", 2 * validation.elements(shape), what="for the readings")
-    with np.errstate(over="ignore", invalid="ignore"):
-        readings = positions[..., :, None] + sigmas[..., None, :] * noise
-    if not np.all(np.isfinite(readings)):
-        raise ValueError(
-            f"the readings overflowed the float64 range: positions, sigmas and noise are too "
-            f"large together (largest magnitudes {np.max(np.abs(positions)):.3g} cm, "
-            f"{np.max(sigmas):.3g} cm and {np.max(np.abs(noise)):.3g})")
-    return readings
+    return _engine.readings(positions, noise, sigmas)
 
 
 def delay_signal(signal: np.ndarray, steps: int, axis: int = -2) -> np.ndarray:

@@ -104,7 +104,7 @@ def moving_average(y: np.ndarray, window: int | np.ndarray) -> np.ndarray:
 
 def _windows(window: object) -> np.ndarray:
     """``window`` as an int array of lengths >= 1, else a ``ValueError`` naming it."""
-    reason = validation._not_real(window)
+    reason = validation.not_real(window)
     array = np.asarray(window) if reason is None else None
     if array is None or array.dtype.kind not in "iuf" or array.size == 0 or np.any(
             ~np.isfinite(array)) or np.any(array != np.round(array)) or np.any(array < 1):

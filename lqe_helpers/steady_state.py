@@ -6,7 +6,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import validation
+from . import _engine, validation
 
 
 @dataclass(frozen=True)
@@ -95,51 +95,7 @@ def steady_state(A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np.ndarray,
             f"has no steady state; add a sensor that reads those states"
         )
 
-    batch = R.shape[:-2]
-    validation.check_memory(f"R of shape {R.shape}",
-                            16 * validation.elements(batch) * max(k, m) ** 2,
-                            what="for the Riccati doubling")
-    identity = np.eye(k)
-    A_i = np.broadcast_to(A.T, (*batch, k, k))
-    G_i = C.T @ np.linalg.solve(R, np.broadcast_to(C, (*batch, m, k)))
-    if np.any(C) and np.any(np.all(G_i == 0, axis=(-2, -1))):
-        raise ValueError(
-            f"C and R must leave the readings some information, got Cᵀ R⁻¹ C = 0 in float64 "
-            f"(C's largest magnitude {np.max(np.abs(C)):.3g}, R's {np.max(np.abs(R)):.3g}): "
-            f"the sensors are worthless at this scale")
-    H_i = np.broadcast_to(Q, (*batch, k, k))
-    change = np.inf
-    for doubling in range(1, max_doublings + 1):
-        # Without a fixed point H grows without bound: overflow is detected just below.
-        with np.errstate(over="ignore", invalid="ignore"):
-            W = np.linalg.inv(identity + G_i @ H_i)
-            A_next = A_i @ W @ A_i
-            G_next = G_i + A_i @ W @ G_i @ A_i.mT
-            H_next = H_i + A_i.mT @ H_i @ W @ A_i
-            H_next = 0.5 * (H_next + H_next.mT)
-        if not np.all(np.isfinite(H_next)):
-            raise ValueError(
-                # Not expected once (A, C) is detectable; kept so that a numerical
-                # breakdown is reported, never returned as a steady state.
-                f"the Riccati recursion has no finite fixed point for these A, C, Q and R "
-                f"(P overflowed at doubling step {doubling}; largest magnitudes: A "
-                f"{np.max(np.abs(A)):.3g}, C {np.max(np.abs(C)):.3g}, Q {np.max(np.abs(Q)):.3g}, "
-                f"R {np.max(np.abs(R)):.3g}): their sizes leave the float64 range, or C does "
-                f"not observe, or Q does not drive, every mode of A that does not decay"
-            )
-        change = np.max(np.abs(H_next - H_i)) / max(np.max(np.abs(H_next)), 1e-300)
-        A_i, G_i, H_i = A_next, 0.5 * (G_next + G_next.mT), H_next
-        if change <= rtol:
-            P = H_i
-            S = C @ P @ C.T + R
-            gain = np.linalg.solve(S, C @ P).mT
-            estimate = P - gain @ C @ P
-            return SteadyState(P, gain, 0.5 * (estimate + estimate.mT))
-    raise ValueError(
-        f"max_doublings = {max_doublings} was too few to reach rtol = {rtol:g}: the last "
-        f"relative change of P was {change:.3g}; allow more doubling steps (the default "
-        f"is 200) or a larger rtol"
-    )
+    return SteadyState(*_engine.riccati(A, C, Q, R, max_doublings, rtol))
 
 
 #: Rank tolerance of the observability matrix, relative to its largest singular value.

@@ -96,7 +96,7 @@ _NOT_REAL_KINDS = {"b": "a boolean (True/False is not a number here)",
                    "M": "a date", "m": "a time interval (give plain seconds)"}
 
 
-def _not_real(value: object) -> str | None:
+def not_real(value: object) -> str | None:
     """Why ``value`` is not real numeric data (a phrase for the message), else None.
 
     Booleans, complex numbers and text convert silently to float in numpy (True is 1,
@@ -114,14 +114,14 @@ def _not_real(value: object) -> str | None:
                 "behind the mask; pass only the valid ones)")
     if isinstance(value, (list, tuple)):
         for item in value:
-            reason = _not_real(item)
+            reason = not_real(item)
             if reason is not None:
                 return reason
         return None
     if isinstance(value, np.ndarray):
         if value.dtype.kind == "O":
             for item in value.flat:
-                reason = _not_real(item)
+                reason = not_real(item)
                 if reason is not None:
                     return reason
             return None
@@ -143,7 +143,7 @@ def _number(name: str, value: object, requirement: str, unit_text: str,
     quotes ``value``; a value that is not a number at all (text, a boolean, a complex
     number, an array, None) is called ``non_numeric`` and the message says what it is.
     """
-    reason = _not_real(value)
+    reason = not_real(value)
     if reason is None and np.ndim(value) != 0:
         reason = "an array (give a single number)"
     if reason is not None:
@@ -244,10 +244,10 @@ def numeric_array(name: str, value: object, min_ndim: int = 0) -> np.ndarray:
     """Return ``value`` as a float array with at least ``min_ndim`` axes; NaN/inf allowed.
 
     Refused: text, booleans and complex numbers (numpy would convert them silently, see
-    :func:`_not_real`), anything that is not a rectangular array of numbers, and an
+    :func:`not_real`), anything that is not a rectangular array of numbers, and an
     empty array (nothing to compute with: ``[]`` where a number or a list is meant).
     """
-    reason = _not_real(value)
+    reason = not_real(value)
     if reason is not None:
         raise ValueError(
             f"{name} must be a numeric array, got {_describe_raw(value)}: "

@@ -1,6 +1,6 @@
 """Checks shared by the explorer tests: find a figure's lines and bands, render it.
 
-Imported by the ``tests/test_explorer*.py`` files as ``explorer_checks`` (pytest puts
+Imported by the ``tests/explorers/test_explorer*.py`` files as ``explorer_checks`` (pytest puts
 ``tests/`` on ``sys.path``, as for ``conftest.py``). Not a test module itself.
 """
 

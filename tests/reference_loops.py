@@ -77,6 +77,53 @@ def lqe_filter(y: np.ndarray, A: np.ndarray, C: np.ndarray, Q: np.ndarray, R: np
     return np.array(estimates)
 
 
+def student_lqe_filter(y, A, C, Q, R, z0, P0) -> np.ndarray:
+    """Eq. (5) as a student writes it in notebook 01: :func:`lqe_filter` without its checks.
+
+    The gain with the explicit inverse ``P Cᵀ (C P Cᵀ + R)⁻¹`` and no input check, so
+    numpy broadcasts what the oracle refuses (a reading of one sensor against a model of
+    two) and NaN readings pass through: what the checks and explorers must cope with.
+    Estimates (n, k), row j after reading ``y[j]``.
+    """
+    z, P, rows = np.array(z0, dtype=float), np.array(P0, dtype=float), []
+    for y_j in y:
+        K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+        z = A @ z + K @ (y_j - C @ A @ z)
+        P = A @ (P - K @ C @ P) @ A.T + Q
+        rows.append(z)
+    return np.array(rows)
+
+
+def filterpy_run(y: np.ndarray, A, C, Q, R, z0, P0) -> dict[str, np.ndarray]:
+    """Eq. (5) by filterpy (an independent implementation), started from the prior A·z0.
+
+    After each ``update(y_j)`` the posterior mean and covariance, the gain, the residual
+    and its covariance; after each ``predict()`` the prior of the next step. Returns
+    arrays by name, each with a leading axis of n: ``estimates`` (n, k), ``gains``
+    (n, k, m), ``estimate_covariances`` and ``covariances`` (n, k, k), ``innovations``
+    (n, m) and ``innovation_covariances`` (n, m, m).
+    """
+    from filterpy.kalman import KalmanFilter
+
+    A, C = np.asarray(A, dtype=float), np.asarray(C, dtype=float)
+    kf = KalmanFilter(dim_x=A.shape[0], dim_z=C.shape[0])
+    kf.F, kf.H, kf.Q, kf.R = A, C, Q, R
+    kf.x, kf.P = A @ z0, np.array(P0, dtype=float)
+    out: dict[str, list[np.ndarray]] = {name: [] for name in (
+        "estimates", "gains", "estimate_covariances", "covariances", "innovations",
+        "innovation_covariances")}
+    for y_j in y:
+        kf.update(y_j)
+        out["estimates"].append(kf.x.copy())
+        out["gains"].append(kf.K.copy())
+        out["estimate_covariances"].append(kf.P.copy())
+        out["innovations"].append(kf.y.copy())
+        out["innovation_covariances"].append(kf.S.copy())
+        kf.predict()
+        out["covariances"].append(kf.P.copy())
+    return {name: np.array(values) for name, values in out.items()}
+
+
 def compensate(estimates: np.ndarray, A: np.ndarray, delay_steps: int) -> np.ndarray:
     """Delay compensation of Tutorial eq. (7): ``z*_j = A^δ ẑ_{j−δ}``.
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from filterpy.kalman import KalmanFilter
+import reference_loops as reference
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -27,22 +27,10 @@ def random_model(rng: np.random.Generator, k: int, m: int) -> dict[str, np.ndarr
 
 
 def filterpy_reference(y: np.ndarray, A, C, Q, R, z0, P0):
-    """Tutorial eq. (5) with filterpy: prior mean A·z0, then update(y_j) and predict()."""
-    k, m = A.shape[0], C.shape[0]
-    kf = KalmanFilter(dim_x=k, dim_z=m)
-    kf.F, kf.H, kf.Q, kf.R = A, C, Q, R
-    kf.x = A @ z0
-    kf.P = P0.copy()
-    estimates, gains, covariances, estimate_covariances = [], [], [], []
-    for y_j in y:
-        kf.update(y_j)
-        estimates.append(kf.x.copy())
-        gains.append(kf.K.copy())
-        estimate_covariances.append(kf.P.copy())
-        kf.predict()
-        covariances.append(kf.P.copy())
-    return (np.array(estimates), np.array(gains), np.array(covariances),
-            np.array(estimate_covariances))
+    """Tutorial eq. (5) with filterpy (``reference_loops.filterpy_run``): estimates, gains,
+    covariances and estimate covariances."""
+    run = reference.filterpy_run(y, A, C, Q, R, z0, P0)
+    return (run["estimates"], run["gains"], run["covariances"], run["estimate_covariances"])
 
 
 @pytest.mark.parametrize(("k", "m"), [(1, 1), (2, 1), (3, 1), (3, 2), (4, 3)])

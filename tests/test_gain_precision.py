@@ -26,7 +26,8 @@ import numpy as np
 import pytest
 
 from lqe_helpers import model
-from lqe_helpers.filter import _covariance_sequence, kalman_filter
+from lqe_helpers._engine import _covariance_sequence
+from lqe_helpers.filter import kalman_filter
 from lqe_helpers.scenario import DEFAULT
 
 mpmath.mp.dps = 50

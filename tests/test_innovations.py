@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from filterpy.kalman import KalmanFilter
+import reference_loops as reference
 
 from lqe_helpers import experiments, metrics, model, simulation
 from lqe_helpers.filter import FilterResult, kalman_filter
@@ -15,16 +15,8 @@ FUSED = ("vision", "proprioception")
 
 def filterpy_innovations(y: np.ndarray, A, C, Q, R, z0, P0) -> tuple[np.ndarray, np.ndarray]:
     """filterpy's residual ``kf.y`` and its covariance ``kf.S`` after each update."""
-    kf = KalmanFilter(dim_x=A.shape[0], dim_z=C.shape[0])
-    kf.F, kf.H, kf.Q, kf.R = A, C, Q, R
-    kf.x, kf.P = A @ z0, P0.copy()
-    values, covariances = [], []
-    for y_j in y:
-        kf.update(y_j)
-        values.append(kf.y.copy())
-        covariances.append(kf.S.copy())
-        kf.predict()
-    return np.array(values), np.array(covariances)
+    run = reference.filterpy_run(y, A, C, Q, R, z0, P0)
+    return run["innovations"], run["innovation_covariances"]
 
 
 @pytest.mark.parametrize(("k", "m"), [(1, 1), (3, 1), (3, 2), (4, 3)])

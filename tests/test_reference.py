@@ -14,7 +14,6 @@ import textwrap
 import numpy as np
 import pytest
 import reference_loops as reference
-from filterpy.kalman import KalmanFilter
 
 from lqe_helpers import model, prediction, scenario, simulation
 from lqe_helpers.filter import kalman_filter
@@ -67,15 +66,8 @@ def test_reference_equals_filterpy() -> None:
     rng = np.random.default_rng(31)
     params = random_model(rng, 3, 2)
     y = 2.0 * rng.normal(size=(40, 2))
-    kf = KalmanFilter(dim_x=3, dim_z=2)
-    kf.F, kf.H, kf.Q, kf.R = params["A"], params["C"], params["Q"], params["R"]
-    kf.x, kf.P = params["A"] @ params["z0"], params["P0"].copy()
-    expected = []
-    for y_j in y:
-        kf.update(y_j)
-        expected.append(kf.x.copy())
-        kf.predict()
-    np.testing.assert_allclose(reference.lqe_filter(y, **params), np.array(expected),
+    expected = reference.filterpy_run(y, **params)["estimates"]
+    np.testing.assert_allclose(reference.lqe_filter(y, **params), expected,
                                rtol=1e-10, atol=1e-10)
 
 
@@ -174,7 +166,7 @@ def test_the_student_pack_holds_no_worked_answer_of_01_or_05() -> None:
     assert (root / "notebooks" / "my_functions" / "my_filter.py").is_file()
     files = student_pack.pack_contents(root)
     assert not [name for name in files if "my_functions" in name or "reference_loops" in name
-                or name in ("tests/test_checks_vision.py", "tests/test_checks_delay.py")]
+                or name.endswith(("/test_checks_vision.py", "/test_checks_delay.py"))]
     worked_lines = ("z = A @ z + K @ (y_j - C @ A @ z)",
                     "z_star[j] = A_delta @ estimates[j - delay_steps]")
     for name, data in files.items():

@@ -86,9 +86,8 @@ def test_a_slider_value_is_checked_once_per_filter_it_reaches(checks_of, module,
     explorer = getattr(module, factory)()
     found = checks_of(value)
     explorer.sliders[slider].value = value
-    ours = [check for check in found if check[0] not in ENGINE]
-    assert len(ours) == filters, ours
-    assert {check[1] for check in ours} <= {"_sensor_sigmas", "track", "_checked"}, ours
+    assert len(found) == filters, found
+    assert {check[1] for check in found} <= {"_sensor_sigmas", "track", "_checked"}, found
 
 
 def test_the_count_sees_a_check_made_twice(checks_of) -> None:
@@ -99,3 +98,43 @@ def test_the_count_sees_a_check_made_twice(checks_of) -> None:
     vision.draw_vision(Figure(), sigma_v=2.3)
     ours = [check for check in found if check[0] not in ENGINE]
     assert [check[1] for check in ours] == ["draw_vision", "_sensor_sigmas"]
+
+
+def test_bad_input_still_meets_the_check_at_each_public_entry() -> None:
+    """Checking once does not mean checking never: every public way in still refuses."""
+    import dataclasses
+
+    from lqe_helpers import experiments, simulation
+    from lqe_helpers.filter import kalman_filter
+    from lqe_helpers.scenario import DEFAULT
+    from lqe_helpers.steady_state import steady_state
+
+    model = experiments.filter_model(DEFAULT)
+    bad_r = np.array([[-1.0]])
+    by_hand = dataclasses.replace(model, R=bad_r)        # not built by filter_model
+    y = np.zeros((DEFAULT.n_steps, 1))
+    for call in (lambda: by_hand.steady_state(), lambda: by_hand.filter(y),
+                 lambda: model.filter(np.full((DEFAULT.n_steps, 1), np.nan)),
+                 lambda: kalman_filter(y, model.A, model.C, model.Q, bad_r, model.z0,
+                                       model.P0),
+                 lambda: steady_state(model.A, model.C, model.Q, bad_r)):
+        with pytest.raises(ValueError, match=r"^(R|y) must"):
+            call()
+    with pytest.raises(ValueError, match=r"sigmas must all be > 0 cm, got \[-1\.5\]"):
+        simulation.measure(DEFAULT.truth[:, 0], y, [-1.5])
+    with pytest.raises(ValueError, match=r"^sigmas .*-1\.5"):
+        experiments.track(DEFAULT, sigmas=[-1.5])
+    with pytest.raises(ValueError, match=r"^sigma_v .*-1\.5"):
+        vision.draw_vision(None, sigma_v=-1.5)
+
+
+def test_a_model_built_by_filter_model_skips_only_the_second_check() -> None:
+    """Its steady state from the core equals the checked entry's, to the bit."""
+    from lqe_helpers import experiments
+    from lqe_helpers.scenario import DEFAULT
+    from lqe_helpers.steady_state import steady_state
+
+    model = experiments.filter_model(DEFAULT, ("vision", "proprioception"), [1.5, 4.5])
+    fast, checked = model.steady_state(), steady_state(model.A, model.C, model.Q, model.R)
+    for name in ("covariance", "gain", "estimate_covariance"):
+        np.testing.assert_array_equal(getattr(fast, name), getattr(checked, name))

@@ -27,7 +27,7 @@ from lqe_helpers import validation
     ],
 )
 def test_not_real_numbers_are_named(value: object, reason: str) -> None:
-    assert validation._not_real(value).startswith(reason)
+    assert validation.not_real(value).startswith(reason)
     with pytest.raises(ValueError, match=rf"^x must be a numeric array, got .*: {reason}"):
         validation.numeric_array("x", value)
 
@@ -36,7 +36,7 @@ def test_not_real_numbers_are_named(value: object, reason: str) -> None:
                                    np.arange(3), np.zeros((2, 2), dtype=np.float32),
                                    [[1.0, np.nan]]])
 def test_real_numbers_pass(value: object) -> None:
-    assert validation._not_real(value) is None
+    assert validation.not_real(value) is None
     array = validation.numeric_array("x", value)
     assert array.dtype == float
     np.testing.assert_array_equal(array, np.asarray(value, dtype=float))

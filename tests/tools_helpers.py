@@ -95,6 +95,7 @@ def make_course(root: Path) -> Path:
     (root / "tests").mkdir()
     (root / "tests" / "test_science.py").write_text("def test_value():\n    assert True\n")
     for name in student_pack.PACK_TESTS:  # the tests the pack ships, here trivial ones
+        (root / "tests" / name).parent.mkdir(parents=True, exist_ok=True)
         (root / "tests" / name).write_text("def test_shipped():\n    assert True\n")
     write_notebook(root / "notebooks" / "01_first.ipynb")
     return root

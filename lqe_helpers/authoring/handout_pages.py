@@ -103,7 +103,8 @@ MathJax.Hub.Config({
 """
 
 # WCAG 2.1 AA: text contrast >= 4.5:1 on the page's white and on the code cells' grey
-# (#f5f5f5); every colour below is >= 4.5:1 on both (checked in tests/test_handout_pages.py).
+# (#f5f5f5); every colour below is >= 4.5:1 on both (checked in
+# tests/authoring/test_handout_pages.py).
 _CSS = r"""
 :root {
   --jp-content-link-color: #0b57d0;

@@ -68,8 +68,9 @@ INSTRUCTOR_PACKAGES = ("authoring",)
 #: The only files of tests/ the pack ships (every other one stays with the instructor):
 #: tests of the pack's infrastructure that hold no worked answer and no task's result.
 PACK_TESTS = ("conftest.py", "test_validation.py", "test_public_errors.py",
-              "test_memory_limits.py", "test_distributions.py", "test_student_code.py",
-              "test_plotting.py", "test_png.py", "test_explorer_cache.py")
+              "test_memory_limits.py", "test_distributions.py",
+              "student_code/test_student_code.py", "test_plotting.py", "explorers/test_png.py",
+              "explorers/test_explorer_cache.py")
 #: Rules of the course Makefile the pack keeps word for word.
 KEPT_RULES = ("$(BIN)/python", "$(STAMP)", "lab", "clean")
 #: A rule's first line in a Makefile (not a variable assignment with ``:=``).

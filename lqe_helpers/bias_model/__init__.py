@@ -39,7 +39,6 @@ from .tracking import (
     DEFAULT_BIAS_PRIOR_STD,
     InputTracking,
     UnbiasedRun,
-    filter_model,
     track_with_input,
     unbiased_run,
 )
@@ -47,7 +46,7 @@ from .tracking import (
 __all__ = [
     "DEFAULT_BIAS", "DEFAULT_BIAS_PRIOR_STD", "DEFAULT_SIGMA_A", "NOISE_COLUMNS",
     "InputTracking", "UnbiasedRun", "acceleration_readings", "bias_drift", "dead_reckoning",
-    "dead_reckoning_spread", "filter_model", "initial_state", "input_matrix",
+    "dead_reckoning_spread", "initial_state", "input_matrix",
     "process_noise_covariance", "step_accelerations", "track_with_input", "transition_matrix",
     "true_states", "unbiased_run", "unit_noise",
 ]

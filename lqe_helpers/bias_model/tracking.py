@@ -1,6 +1,8 @@
 """The filter with the biased signal as input, and its runs (notebook 06 and its explorer).
 
-:func:`filter_model` builds the model the filter assumes. A run is made in one place,
+The model the filter assumes (Lesson 0.5 eqs. (4)–(9)) is assembled inside this module,
+for its runs (:attr:`UnbiasedRun.model`); the butterfly's model has its one builder,
+:func:`lqe_helpers.experiments.filter_model`. A run is made in one place,
 :func:`unbiased_run`, for notebook 06 (through :func:`track_with_input`) and for the
 explorer alike. The filter is linear in its input, so the run at a true bias b is the
 run at b = 0 plus b times the response to a unit input (:meth:`UnbiasedRun.at_bias`):
@@ -13,10 +15,11 @@ Each public function checks its inputs once, at its entry.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .. import _matrices, metrics, simulation, validation
+from .. import _engine, _matrices, metrics, validation
 from ..experiments import FilterModel
 from ..filter import FilterResult
 from ..scenario import Scenario
@@ -34,6 +37,9 @@ from .equations import (
     unit_noise,
 )
 
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
 #: The filter's prior standard deviation of the bias (cm/s²): the observer allows
 #: offsets up to about half the peak acceleration before it has seen anything.
 DEFAULT_BIAS_PRIOR_STD = 50.0
@@ -41,7 +47,14 @@ DEFAULT_BIAS_PRIOR_STD = 50.0
 
 def _assemble(scenario: Scenario, sigma_a: float, sigma_v: float,
               bias_prior_std: float) -> FilterModel:
-    """The model of :func:`filter_model` from inputs its caller has checked."""
+    """The model the filter of :func:`track_with_input` assumes, from checked inputs.
+
+    ``A = F`` and ``B = G`` (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)),
+    ``C = [1, 0, 0]``, ``R = σ_v²``, ``z0 = [0, 0, 0]`` and
+    ``P0 = diag(A², (A·2πf)², bias_prior_std²)``: one amplitude A for position, the
+    path's peak speed for velocity. σ_a (cm/s²), σ_v (cm) and ``bias_prior_std``
+    (cm/s²) already checked (:func:`_checked`).
+    """
     dt = scenario.dt
     g = input_matrix(dt)
     return FilterModel(
@@ -60,36 +73,6 @@ def _checked(scenario: Scenario, sigma_a: float, sigma_v: float | None,
             validation.positive("sigma_v", scenario.sigma_v if sigma_v is None else sigma_v,
                                 "cm"),
             validation.positive("bias_prior_std", bias_prior_std, "cm/s²"))
-
-
-def filter_model(scenario: Scenario, sigma_a: float, sigma_v: float,
-                 bias_prior_std: float = DEFAULT_BIAS_PRIOR_STD) -> FilterModel:
-    """The model the filter of :func:`track_with_input` assumes.
-
-    ``A = F`` and ``B = G`` (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)),
-    ``C = [1, 0, 0]``, ``R = σ_v²``, ``z0 = [0, 0, 0]`` and
-    ``P0 = diag(A², (A·2πf)², bias_prior_std²)``: one amplitude A for position, the
-    path's peak speed for velocity. Its :meth:`~lqe_helpers.experiments.FilterModel.filter`
-    takes the measurements and the input u.
-
-    Parameters
-    ----------
-    scenario : Scenario
-        Supplies Δt and the path's amplitude and frequency.
-    sigma_a : float
-        Noise σ_a of the acceleration signal in cm/s², > 0.
-    sigma_v : float
-        Vision noise σ_v in cm, > 0.
-    bias_prior_std : float
-        The prior standard deviation of the bias in cm/s², > 0.
-
-    Returns
-    -------
-    FilterModel
-        ``A`` (3, 3), ``C`` (1, 3), ``Q`` (3, 3), ``R`` (1, 1), ``z0`` (3,), ``P0`` (3, 3)
-        and ``B`` (3, 1).
-    """
-    return _assemble(scenario, *_checked(scenario, sigma_a, sigma_v, bias_prior_std))
 
 
 @dataclass(frozen=True)
@@ -147,6 +130,44 @@ class InputTracking:
         """Per-run MSE (cm²) of the filtered position after the burn-in, shape (...)."""
         return metrics.mse(self.positions, self.truth[:, 0], self.scenario.burn_in_steps)
 
+    def bias_rms_error(self) -> np.ndarray:
+        """Root-mean-square error of b̂ over the runs (axis 0) against time (cm/s²), (..., n)."""
+        return np.sqrt(np.mean((self.bias_estimates - self.bias) ** 2, axis=0))
+
+    def learning_figure(self, runs: InputTracking) -> Figure:
+        """Notebook 06's Figure 1: this run's b̂ with its band, and the runs' error of b̂.
+
+        Built by :func:`lqe_helpers.figures.bias_learning_figure`, so a notebook passes
+        two results instead of six arrays.
+
+        Parameters
+        ----------
+        runs : InputTracking
+            Monte Carlo runs (one leading axis) of the same scenario, bias and σ's:
+            their RMS error of b̂ (:meth:`bias_rms_error`) and the filter's own σ of it.
+
+        Raises
+        ------
+        ValueError
+            If this tracking is not a single run, or ``runs`` is not a batch of runs of
+            the same experiment.
+        """
+        from .. import figures
+
+        if self.bias_estimates.ndim != 1:
+            raise ValueError(f"learning_figure draws a single run: this tracking has leading "
+                             f"axes {self.bias_estimates.shape[:-1]}")
+        if not (isinstance(runs, InputTracking) and runs.bias_estimates.ndim == 2
+                and (runs.scenario, runs.bias, runs.sigma_a, runs.sigma_v)
+                == (self.scenario, self.bias, self.sigma_a, self.sigma_v)):
+            raise ValueError(
+                "runs must be an InputTracking of Monte Carlo runs (one leading axis) of "
+                "this run's scenario, bias, sigma_a and sigma_v, got "
+                f"{type(runs).__name__}")
+        return figures.bias_learning_figure(self.scenario.times, self.bias_estimates,
+                                            self.bias_stds, self.bias, runs.bias_rms_error(),
+                                            runs.bias_stds[0])
+
     def dead_reckoning_mse(self) -> np.ndarray:
         """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
         return metrics.mse(self.dead_reckoning[..., 0], self.truth[:, 0],
@@ -178,6 +199,8 @@ class UnbiasedRun:
     unit_response : ndarray, shape (n, 3)
         The estimates ``[p̂, v̂, b̂]`` for no measurement and a unit input (cm/s², per cm/s²
         of bias).
+    model : FilterModel
+        The model the filter assumed (A = F, B = G, Q = G σ_a² Gᵀ, C, R = σ_v², z0, P0).
     """
 
     scenario: Scenario
@@ -188,12 +211,13 @@ class UnbiasedRun:
     readings: np.ndarray
     result: FilterResult
     unit_response: np.ndarray
+    model: FilterModel
 
     def at_bias(self, bias: float) -> InputTracking:
         """The run of :func:`track_with_input` at true bias ``bias`` (cm/s², any sign).
 
         Equal to the filter run on the biased signal to rounding (1e-9,
-        ``tests/test_bias_model.py``); dead reckoning integrates the biased signal.
+        ``tests/bias_model/test_bias_model.py``); dead reckoning integrates the biased signal.
 
         Raises
         ------
@@ -224,7 +248,7 @@ def unbiased_run(scenario: Scenario, sigma_a: float = DEFAULT_SIGMA_A,
                  noise: np.ndarray | None = None) -> UnbiasedRun:
     """Simulate vision and the signal at b = 0, and filter both it and a unit input.
 
-    One call of the filter of :func:`filter_model` on the runs and one more run (no
+    One call of the filter of :func:`_assemble` on the runs and one more run (no
     measurement, an input of 1 cm/s² at every step): they share the gains.
 
     Parameters
@@ -253,15 +277,18 @@ def unbiased_run(scenario: Scenario, sigma_a: float = DEFAULT_SIGMA_A,
         noise = unit_noise(scenario, runs)
     expected = (scenario.n_steps, 2) if runs is None else (runs, scenario.n_steps, 2)
     noise = validation.shaped_array("noise", noise, expected, ", ".join(NOISE_COLUMNS))
-    measurements = simulation.measure(scenario.truth[:, 0], noise[..., :1],
-                                      np.array([sigma_v]))
+    # Everything is checked above: the engine's core checks nothing again, so a
+    # slider's σ_v is checked once on its way to the filter.
+    measurements = _engine.readings(scenario.truth[:, 0], noise[..., :1], np.array([sigma_v]))
     readings = acceleration_readings(step_accelerations(scenario), 0.0, sigma_a,
                                      noise[..., 1])
     # The runs, then one more: no measurement and a unit input, filtered together.
     n, batch = scenario.n_steps, measurements.shape[:-2]
     y = np.concatenate([measurements.reshape(-1, n, 1), np.zeros((1, n, 1))])
     u = np.concatenate([readings.reshape(-1, n, 1), np.ones((1, n, 1))])
-    both = _assemble(scenario, sigma_a, sigma_v, bias_prior_std).filter(y, u)
+    model = _assemble(scenario, sigma_a, sigma_v, bias_prior_std)
+    both = _engine.filter_run(y, model.A, model.C, model.Q, model.R, model.z0, model.P0,
+                              B=model.B, u=u)
 
     def runs_only(array: np.ndarray) -> np.ndarray:
         return array[:-1].reshape(*batch, *array.shape[1:])
@@ -269,7 +296,7 @@ def unbiased_run(scenario: Scenario, sigma_a: float = DEFAULT_SIGMA_A,
     result = FilterResult(*(runs_only(getattr(both, name)) for name in (
         "estimates", "gains", "covariances", "estimate_covariances")))
     return UnbiasedRun(scenario, sigma_a, sigma_v, bias_prior_std, measurements, readings,
-                       result, both.estimates[-1])
+                       result, both.estimates[-1], model)
 
 
 def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
@@ -281,7 +308,7 @@ def track_with_input(scenario: Scenario, bias: float = DEFAULT_BIAS,
 
     The filter is :func:`~lqe_helpers.filter.kalman_filter` with ``A = F``, ``B = G``
     (Lesson 0.5 eq. (5)), ``Q = G σ_a² Gᵀ`` (eq. (9)), ``C = [1, 0, 0]`` and
-    ``R = σ_v²`` (:func:`filter_model`). It starts from ``z0 = [0, 0, 0]`` with prior
+    ``R = σ_v²`` (:func:`_assemble`). It starts from ``z0 = [0, 0, 0]`` with prior
     standard deviations of one amplitude A for position, the path's peak speed A·2πf
     for velocity and ``bias_prior_std`` for the bias: the observer knows the range of
     the movement and roughly how large a bias can be, nothing more. Made as

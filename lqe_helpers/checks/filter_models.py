@@ -14,14 +14,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import model
-from ..filter import kalman_filter
+from ..filter import FILTER_ARGS, kalman_filter
 from .machinery import SEED
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
-
-
-#: The parameters of ``my_filter(y, A, C, Q, R, z0, P0)``, in order (Tutorial eq. (5)).
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
 
 
 @dataclass(frozen=True)

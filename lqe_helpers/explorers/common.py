@@ -20,12 +20,11 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from .. import experiments
-from ..plotting import style
+from ..figures.common import TrialLine, trial_column
 from ..scenario import Scenario
 
-#: A line of a trial's left column: (panel, role, legend label or None). Panel 0
-#: holds the signals, panel 1 the errors (estimate − true position).
-TrialLine = tuple[int, str, str | None]
+__all__ = ["TrialLine", "TrialPanels", "build_trial_panels", "estimate_lines",
+           "legend_handles", "position_shares", "significant", "trial_numbers"]
 
 
 class TrialPanels(NamedTuple):
@@ -45,8 +44,10 @@ def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, T
 
     The left column holds the signals (position, ±``signal_limit`` cm) above the
     errors (estimate − true position, ±``error_limit`` cm, with a zero line); each
-    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data.
-    The caller adds the legend and fills the side panel.
+    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data,
+    drawn by the notebooks' painter of this picture
+    (:func:`lqe_helpers.figures.common.trial_column`). The caller adds the legend and
+    fills the side panel.
     """
     grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
                                left=0.07, right=0.98, bottom=0.1, top=top,
@@ -54,22 +55,16 @@ def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, T
     signals = figure.add_subplot(grid[0, 0])
     errors = figure.add_subplot(grid[1, 0], sharex=signals)
     side = figure.add_subplot(grid[:, 1])
-    times = scenario.times
-    column = (signals, errors)
-    drawn = {}
-    for gid, (panel, role, label) in lines.items():
-        extra = {"linewidth": 1.0} if panel == 1 else {}
-        (drawn[gid],) = column[panel].plot(times, np.zeros_like(times),
-                                           **style(role, gid=gid, label=label, **extra))
+    drawn = trial_column(signals, errors, scenario.times, lines, error_linewidth=1.0,
+                         zero_line_first=False)
     signals.set_ylim(-signal_limit, signal_limit)
     signals.set_ylabel("position (cm)")
     signals.tick_params(labelbottom=False)
-    errors.axhline(0.0, **style("truth", linewidth=0.8))
     errors.set_ylim(-error_limit, error_limit)
     errors.set_xlim(0.0, scenario.duration)
     errors.set_xlabel("time (s)")
     errors.set_ylabel("error (cm)")
-    figure.align_ylabels(column)
+    figure.align_ylabels((signals, errors))
     return TrialPanels(signals, errors, side, drawn)
 
 

@@ -31,7 +31,8 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from .. import experiments, student_code
-from ..plotting import COLORS, style
+from ..figures.common import TrialLine, trial_column
+from ..plotting import COLORS
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
@@ -50,7 +51,7 @@ WINDOW = 4.0
 SENSORS = ("vision",)
 
 # gid of each line → (axes index, role, legend label). The gids let tests find them.
-_LINES = {
+_LINES: dict[str, TrialLine] = {
     "vision": (0, "vision", "vision, delayed  $y_{j-δ}$"),
     "truth": (0, "truth", "true position"),
     "delayed": (0, "estimate", "delayed estimate  $\\hat z_{j-δ}$"),
@@ -250,18 +251,16 @@ def _build(figure: Figure, scenario: Scenario) -> _Panels:
     """Build the two axes of :func:`draw_delay` on the empty ``figure``, lines empty."""
     axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
     figure.subplots_adjust(top=0.91, bottom=0.1, hspace=0.12)
-    lines = {}
-    for gid, (index, role, label) in _LINES.items():
-        kwargs = {"linewidth": 1.2} if index == 1 else {}
-        (lines[gid],) = axes[index].plot([], [], **style(role, label=label, gid=gid, **kwargs))
+    top, bottom = axes
+    # The notebooks' painter of a trial's signals over its errors, with no data yet.
+    lines = trial_column(top, bottom, np.empty(0), _LINES, error_linewidth=1.2,
+                         zero_line_first=False)
     handles = [lines[gid] for gid, (index, _, _) in _LINES.items() if index == 0]
     handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
                          label="nothing has arrived yet"))
     figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.995), ncol=5,
                   fontsize=8, handlelength=2.2, columnspacing=1.2, markerscale=2.5)
-    top, bottom = axes
     top.set_ylabel("position (cm)")
-    bottom.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
     # Under the band and the lines (above the grid's zorder 1.5): a fixed text painted
     # before what a move changes stays in the cached layer; above the band it would be
     # repainted with it on every move (the band's extent is its whole axes). The band

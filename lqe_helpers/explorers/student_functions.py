@@ -18,9 +18,8 @@ import dataclasses
 from collections.abc import Callable
 
 from .. import experiments, student_code
+from ..filter import FILTER_ARGS
 
-#: Parameters of a student's filter ``my_filter(y, A, C, Q, R, z0, P0)`` (Tutorial eq. (5)).
-FILTER_ARGS = ("y", "A", "C", "Q", "R", "z0", "P0")
 #: What the numbers line says made the estimates when no student's filter is given.
 ENGINE = "the pack's engine"
 #: The last step of the "not written yet" advice in an explorer: the explorer keeps the

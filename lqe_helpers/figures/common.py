@@ -1,7 +1,8 @@
 """What several notebooks' figures share: two figures, and the pieces every figure is made of.
 
 The figures: :func:`tracking_comparison_figure` (estimates beside the truth, their errors
-below; notebooks 01, 03, 04, 05) and :func:`paired_mse_figure` (one point per Monte
+below; notebooks 01, 03, 04, 05; its painter :func:`trial_column` draws the explorers'
+trials of 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
 Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 (:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
@@ -19,11 +20,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
 from ..plotting import COLORS, style
 
 #: A series to draw: (values, shape (n,); style role; legend label or None).
 Series = tuple[np.ndarray, str, "str | None"]
+#: A line of a trial column (:func:`trial_column`): (panel, style role, legend label or
+#: None). Panel 0 holds the signals, panel 1 the errors (estimate − true position).
+TrialLine = tuple[int, str, "str | None"]
 
 
 def interval_arrays(intervals: Iterable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -172,6 +177,56 @@ def legend_above(ax: Axes, title: str = "") -> None:
     ax.set_title(title, pad=22)
 
 
+def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
+                 lines: Mapping[str, TrialLine],
+                 values: Mapping[str, np.ndarray] | None = None, *,
+                 error_linewidth: float, zero_line_first: bool) -> dict[str, Line2D]:
+    """Draw one trial's signals over its errors: the one painter of that picture.
+
+    Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 and
+    :meth:`lqe_helpers.experiments.Tracking.figure`) and by the explorers of 03, 04 and 05
+    (:func:`lqe_helpers.explorers.common.build_trial_panels`,
+    :func:`lqe_helpers.explorers.delay.draw_delay`), which draw with no data and then
+    refill these lines on every slider move.
+
+    Parameters
+    ----------
+    signals, errors : matplotlib.axes.Axes
+        The top (position, cm) and bottom (estimate − true position, cm) panels.
+    times : array_like, shape (n,)
+        Sample times (s).
+    lines : mapping of str to (panel, role, label)
+        By gid, in drawing order: each becomes one line in its role's style (on the
+        errors panel with ``error_linewidth``).
+    values : mapping of str to array_like, shape (n,), optional
+        The y data (cm) of each line, by gid; None draws every line as zeros, waiting
+        for data.
+    error_linewidth : float
+        Line width (pt) of the lines on the errors panel.
+    zero_line_first : bool
+        Whether the errors panel's zero line (black, 0.8 pt) is drawn before its lines
+        (under them, as the notebooks' figures do) or after them.
+
+    Returns
+    -------
+    dict of str to Line2D
+        The drawn lines by gid.
+    """
+    times = np.asarray(times, dtype=float)
+    panels = (signals, errors)
+    if zero_line_first:
+        errors.axhline(0.0, **style("truth", linewidth=0.8))
+    drawn = {}
+    for gid, (panel, role, label) in lines.items():
+        extra = {"linewidth": error_linewidth} if panel == 1 else {}
+        y = np.zeros_like(times) if values is None else np.asarray(values[gid], dtype=float)
+        (drawn[gid],) = panels[panel].plot(times, y, **style(role, gid=gid, label=label,
+                                                             **extra))
+    if not zero_line_first:
+        errors.axhline(0.0, **style("truth", linewidth=0.8))
+    return drawn
+
+
 def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
                                estimates: dict[str, tuple[np.ndarray, str]],
                                readings: dict[str, tuple[np.ndarray, str]] | None = None,
@@ -196,21 +251,25 @@ def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
     Returns
     -------
     Figure
-        Two panels sharing the time axis; lines in the order readings, truth, estimates;
-        the legend in one row above the top panel, under its title, clear of the data.
+        Two panels sharing the time axis, drawn by :func:`trial_column`; lines in the
+        order readings, truth, estimates; the legend in one row above the top panel,
+        under its title, clear of the data.
     """
     times = np.asarray(times, dtype=float)
     truth = np.asarray(truth, dtype=float)
     fig, (ax_top, ax_err) = plt.subplots(2, 1, figsize=(10, 6.2), sharex=True,
                                          gridspec_kw={"height_ratios": [1.5, 1]})
-    plot_series(ax_top, times, [(values, role, label)
-                                for label, (values, role) in (readings or {}).items()])
-    ax_top.plot(times, truth, **style("truth", label="true position"))
-    ax_err.axhline(0.0, color=COLORS["truth"], linewidth=0.8)
-    for label, (values, role) in estimates.items():
-        values = np.asarray(values, dtype=float)
-        ax_top.plot(times, values, **style(role, label=label))
-        ax_err.plot(times, values - truth, **style(role, linewidth=1.1, label=label))
+    lines: dict[str, TrialLine] = {}
+    values: dict[str, np.ndarray] = {}
+    for label, (series, role) in (readings or {}).items():
+        lines[f"reading: {label}"], values[f"reading: {label}"] = (0, role, label), series
+    lines["truth"], values["truth"] = (0, "truth", "true position"), truth
+    for label, (series, role) in estimates.items():
+        series = np.asarray(series, dtype=float)
+        lines[f"estimate: {label}"], values[f"estimate: {label}"] = (0, role, label), series
+        lines[f"error: {label}"], values[f"error: {label}"] = (1, role, label), series - truth
+    trial_column(ax_top, ax_err, times, lines, values, error_linewidth=1.1,
+                 zero_line_first=True)
     label_axes(ax_top, ylabel="position (cm)")
     legend_above(ax_top, title)
     label_axes(ax_err, "time (s)", "error (cm)", xlim=(times[0], times[-1]))

@@ -28,7 +28,7 @@ from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError
 from lqe_helpers.authoring.manifest import MANIFEST_NAME
 from lqe_helpers.authoring.student_edition import EXPLORER_TAG
 
-NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 REAL = sorted(path.stem for path in NOTEBOOKS.glob("*.ipynb"))
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"

@@ -13,7 +13,7 @@ from lqe_helpers import checks
 from lqe_helpers.authoring import marking_guide as mg
 from lqe_helpers.authoring import student_edition as se
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 TASK = ("# Task: compute the fused MSE after the burn-in (cm²) with metrics.mse\n"
         "#       and print it.\nmse = metrics.mse(estimate, truth)\nprint(f'{mse:.3f}')")

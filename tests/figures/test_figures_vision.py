@@ -1,4 +1,4 @@
-"""Figures of notebook 01 that tests/test_figures.py does not cover: the lag figure."""
+"""Figures of notebook 01 that tests/figures/test_figures.py does not cover: the lag figure."""
 
 from __future__ import annotations
 

@@ -37,7 +37,7 @@ from lqe_helpers.explorers import (
 )
 from lqe_helpers.scenario import DEFAULT
 
-NOTEBOOKS = Path(__file__).resolve().parents[1] / "notebooks"
+NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 
 #: notebook → (explorer module, its factory).
 EXPLORERS = {

@@ -129,7 +129,8 @@ def test_dead_reckoning_equals_the_step_by_step_recursion(seed: int) -> None:
 def test_filter_model_is_the_one_track_with_input_uses() -> None:
     """Lesson 0.5 eqs. (5) and (9), vision reading the position, P0 spanning the path."""
     scenario = dataclasses.replace(DEFAULT, amplitude=4.0, frequency=1.5)
-    model = bias_model.filter_model(scenario, sigma_a=30.0, sigma_v=2.5, bias_prior_std=40.0)
+    model = bias_model.unbiased_run(scenario, sigma_a=30.0, sigma_v=2.5,
+                                    bias_prior_std=40.0).model
     dt = scenario.dt
     np.testing.assert_array_equal(model.A, [[1, dt, -dt**2 / 2], [0, 1, -dt], [0, 0, 1]])
     np.testing.assert_array_equal(model.B, [[dt**2 / 2], [dt], [0]])
@@ -151,7 +152,7 @@ def test_filter_model_is_the_one_track_with_input_uses() -> None:
     for name, value in (("sigma_a", 0.0), ("sigma_v", -1.0), ("bias_prior_std", 0.0)):
         arguments = {"sigma_a": 30.0, "sigma_v": 2.5, "bias_prior_std": 40.0, name: value}
         with pytest.raises(ValueError, match=name):
-            bias_model.filter_model(scenario, **arguments)
+            bias_model.unbiased_run(scenario, **arguments)
 
 
 def _biased_filter_by_hand(scenario, bias: float, sigma_a: float, sigma_v: float,
@@ -204,7 +205,7 @@ def test_unbiased_run_at_a_bias_is_the_filter_fed_that_biased_signal(bias, sigma
 
 def test_unit_response_is_the_filter_of_a_constant_unit_input_alone() -> None:
     run = bias_model.unbiased_run(DEFAULT)
-    model = bias_model.filter_model(DEFAULT, bias_model.DEFAULT_SIGMA_A, DEFAULT.sigma_v)
+    model = run.model
     alone = model.filter(np.zeros((DEFAULT.n_steps, 1)), np.ones((DEFAULT.n_steps, 1)))
     np.testing.assert_allclose(run.unit_response, alone.estimates, rtol=1e-12, atol=1e-12)
     # Its bias estimate learns the unit step: b̂ → 1 (the bias the filter must remove).
@@ -400,3 +401,29 @@ def test_bad_input_messages(call, message: str) -> None:
 def test_bad_input_is_rejected_by_name(call, name: str) -> None:
     with pytest.raises(ValueError, match=name):
         call()
+
+
+@pytest.mark.slow
+def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
+    """``run.learning_figure(mc)`` draws what six arrays drew, pixel for pixel."""
+    import matplotlib.pyplot as plt
+
+    from lqe_helpers import figures, plotting
+
+    b_true = bias_model.DEFAULT_BIAS
+    run = bias_model.track_with_input(DEFAULT, bias=b_true)
+    mc = bias_model.track_with_input(DEFAULT, bias=b_true, runs=20)
+    rms = np.sqrt(np.mean((mc.bias_estimates - b_true) ** 2, axis=0))   # by hand
+    np.testing.assert_array_equal(mc.bias_rms_error(), rms)
+    by_arrays = figures.bias_learning_figure(DEFAULT.times, run.bias_estimates, run.bias_stds,
+                                             b_true, rms, mc.bias_stds[0])
+    by_object = run.learning_figure(mc)
+    try:
+        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
+    finally:
+        plt.close(by_arrays)
+        plt.close(by_object)
+    other = bias_model.track_with_input(DEFAULT, bias=b_true + 1.0, runs=3)
+    for wrong_run, runs in ((mc, mc), (run, run), (run, other), (run, "mc")):
+        with pytest.raises(ValueError, match=r"single run|runs must be"):
+            wrong_run.learning_figure(runs)

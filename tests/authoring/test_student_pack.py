@@ -31,10 +31,10 @@ from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
 from lqe_helpers.authoring.errors import OutputFolderError
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("*.ipynb"))
 #: Unit tests run inside the pack besides the structure tests (the rest are collected).
-SAMPLE_UNIT_TESTS = ("test_student_code", "test_validation")
+SAMPLE_UNIT_TESTS = ("student_code/test_student_code", "test_validation")
 
 
 @pytest.fixture
@@ -128,7 +128,9 @@ def test_every_test_the_pack_ships_exists_and_needs_nothing_of_the_instructor(na
 def test_a_new_test_stays_with_the_instructor_unless_it_is_listed():
     """The pack lists what may ship: a test added to tests/ is left out by default."""
     shipped = set(sp.PACK_TESTS)
-    assert {path.name for path in (ROOT / "tests").glob("test_checks_*.py")}.isdisjoint(shipped)
+    checks_tests = {path.relative_to(ROOT / "tests").as_posix()
+                    for path in (ROOT / "tests").rglob("test_checks_*.py")}
+    assert checks_tests and checks_tests.isdisjoint(shipped)
     assert {"reference_loops.py", "test_reference.py", "test_smoothing.py",
             "test_science_numbers.py", "check_outcomes.py"}.isdisjoint(shipped)
 
@@ -248,7 +250,8 @@ def test_the_packs_make_test_passes_with_this_interpreter(pack, tmp_path):
     folder = writable_copy(packed, tmp_path / sp.PACK_NAME)  # pytest writes caches there
     [command] = [line for line in dry_run(folder, "test") if " -m pytest" in line]
     argv = [sys.executable, *shlex.split(command)[1:], "-p", "no:cacheprovider", "-q"]
-    sample = " or ".join([sp.STRUCTURE_TEST.removesuffix(".py"), *SAMPLE_UNIT_TESTS])
+    sample = " or ".join([sp.STRUCTURE_TEST.removesuffix(".py"),
+                          *(name.rsplit("/", 1)[-1] for name in SAMPLE_UNIT_TESTS)])
     # One run: pytest collects every test (an error in any stops the run), then runs the
     # sample; -rA lists each test that passed.
     result = subprocess.run([*argv, "-k", sample, "-rA"], cwd=folder, capture_output=True,
