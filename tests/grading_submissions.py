@@ -1,6 +1,6 @@
 """Simulated submissions of notebook 01, made from the worked notebook and its student edition.
 
-Used by the grading tests (tests/test_grading_*.py) and benchmarks/bench_grading.py. Each
+Used by the grading tests (tests/authoring/test_grading*.py) and benchmarks/bench_grading.py. Each
 maker returns the text of an ``.ipynb`` file (or raw bytes for the broken ones).
 """
 

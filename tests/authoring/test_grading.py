@@ -16,7 +16,7 @@ from lqe_helpers.authoring.marking_guide import QUESTION_MARKS, question_and_mar
 from lqe_helpers.authoring.student_edition import student_edition
 from lqe_helpers.authoring.task_cells import stub_source
 
-NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("*.ipynb"))
+NOTEBOOKS = sorted((Path(__file__).resolve().parents[2] / "notebooks").glob("*.ipynb"))
 
 
 def plan(path: Path) -> list[grading.GradedCell]:

@@ -131,7 +131,7 @@ CASES = [("bare_except_around_loop", 5.0), ("except_base_continue", 0.5),
 def test_a_swallowed_time_out_fails_its_check_within_10_s(tmp_path: Path) -> None:
     (tmp_path / "students.py").write_text(STUDENTS)
     environment = dict(os.environ, PYTHONPATH=os.pathsep.join(
-        [str(Path(__file__).resolve().parent.parent), os.environ.get("PYTHONPATH", "")]))
+        [str(Path(__file__).resolve().parents[2]), os.environ.get("PYTHONPATH", "")]))
     try:
         done = subprocess.run([sys.executable, "-c", CHILD, str(tmp_path), json.dumps(CASES)],
                               capture_output=True, text=True, timeout=60, env=environment)
