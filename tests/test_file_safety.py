@@ -19,7 +19,7 @@ import pytest
 from nbformat.v4 import new_code_cell, new_notebook
 from tools_helpers import snapshot
 
-from lqe_helpers.authoring import command_line, files, manifest, notebook_io, transaction
+from lqe_helpers.authoring import command_line, files, manifest, notebook_io, swap
 from lqe_helpers.authoring.errors import (
     FileSafetyError,
     NotebookFileError,
@@ -92,7 +92,7 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
     # A full disk while the second is being written: nothing replaced yet.
     monkeypatch.setattr(files, "_write_fd", full_disk_after(3))
     with pytest.raises(OSError):
-        transaction.atomic_write_many({first: "good after", second: "other after"})
+        swap.atomic_write_many({first: "good after", second: "other after"})
     assert snapshot(tmp_path) == before
     monkeypatch.undo()
 
@@ -106,11 +106,11 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
 
     monkeypatch.setattr(os, "replace", replace)
     with pytest.raises(OSError):
-        transaction.atomic_write_many({first: "good after", second: "other after"})
+        swap.atomic_write_many({first: "good after", second: "other after"})
     monkeypatch.undo()
     assert snapshot(tmp_path) == before
 
-    assert transaction.atomic_write_many({first: "good after",
+    assert swap.atomic_write_many({first: "good after",
                                           second: b"other after"}) == [first, second]
     assert (first.read_text(), second.read_text()) == ("good after", "other after")
     assert sorted(os.listdir(tmp_path)) == ["good.ipynb", "other.ipynb"]
@@ -323,14 +323,14 @@ def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
     out = tmp_path / "out"
     write_output_folder(out, {"01.html": "one"}, tool="handouts")
     before = snapshot(tmp_path)
-    real_mkstemp = files.tempfile.mkstemp
+    real_mkdir = os.mkdir
 
-    def read_only(*args, dir=None, **kwargs):  # the first file a build creates in out
-        if Path(dir) == out:
+    def read_only(path, *args, **kwargs):  # the first thing a build creates in out
+        if Path(path).parent == out:
             raise OSError(errno.EROFS, "Read-only file system", str(out))
-        return real_mkstemp(*args, dir=dir, **kwargs)
+        return real_mkdir(path, *args, **kwargs)
 
-    monkeypatch.setattr(files.tempfile, "mkstemp", read_only)
+    monkeypatch.setattr(os, "mkdir", read_only)
     with pytest.raises(OutputWriteError, match=f"cannot write into {out}: Read-only file system"):
         write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
     assert snapshot(tmp_path) == before

@@ -195,6 +195,29 @@ def link_or_copy(source: Path, target: Path) -> None:
         shutil.copy2(source, target, follow_symlinks=False)
 
 
+def regular_file_bytes(path: Path, limit: int, what: str = "file") -> bytes:
+    """The content of the regular file ``path`` of at most ``limit`` bytes.
+
+    Checked before it is opened (a fifo or a device never blocks, a huge file is never
+    read) and opened without following a link.
+
+    Raises
+    ------
+    ValueError
+        Saying why: not a regular file, or larger than ``limit`` (a ``what``'s).
+    OSError
+        If it cannot be read.
+    """
+    status = os.lstat(path)
+    if not stat.S_ISREG(status.st_mode):
+        raise ValueError("not a regular file (a link, a folder, a fifo or a device)")
+    if status.st_size > limit:
+        raise ValueError(f"{status.st_size} bytes, more than a {what}'s {limit}")
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | os.O_NONBLOCK)
+    with open(fd, "rb") as file:
+        return file.read(limit + 1)[:limit + 1]
+
+
 def sha256(data: bytes) -> str:
     """Hex SHA-256 of ``data``."""
     return hashlib.sha256(data).hexdigest()
