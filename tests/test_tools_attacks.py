@@ -10,27 +10,26 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import stat
-import warnings
 import resource
+import stat
 import subprocess
+import warnings
 from pathlib import Path
 
 import pytest
 from tools_helpers import (
     MANIFEST,
+    error_lines,
     python_command,
     run_tool,
     snapshot,
     tools_environment,
-    error_lines,
     write_notebook,
 )
 
 from lqe_helpers.authoring.errors import OutputFolderError
-from lqe_helpers.authoring.swap import JOURNAL_NAME, RecoveryWarning
 from lqe_helpers.authoring.output_folder import write_output_folder
-from lqe_helpers.authoring.swap import FolderLock
+from lqe_helpers.authoring.swap import JOURNAL_NAME, FolderLock, RecoveryWarning
 
 
 def journal(staging: str, writes: list | None = None, deletes: list | None = None, *,

@@ -30,7 +30,6 @@ import re
 import secrets
 import shutil
 import signal
-import stat
 import threading
 import warnings
 from collections.abc import Iterator, Mapping
@@ -412,7 +411,7 @@ def _lock(fd: int) -> bool:
     """Lock the open folder ``fd`` (``filelock``'s flock); ``False`` if another holds it."""
     if lock_descriptor is not None:
         return lock_descriptor(fd, blocking=False)
-    import fcntl  # noqa: PLC0415 (only without filelock, on POSIX)
+    import fcntl
 
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
