@@ -97,14 +97,14 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
     monkeypatch.undo()
 
     # The second move fails after the first one was made: the first is put back.
-    real_replace = os.replace
+    real_link = os.link
 
-    def replace(source, target, *args, **kwargs):
+    def link(source, target, *args, **kwargs):  # a new file is linked into place
         if Path(target) == second:
             raise OSError(errno.EACCES, "Permission denied", str(target))
-        return real_replace(source, target, *args, **kwargs)
+        return real_link(source, target, *args, **kwargs)
 
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "link", link)
     with pytest.raises(OSError):
         swap.atomic_write_many({first: "good after", second: "other after"})
     monkeypatch.undo()
@@ -301,16 +301,16 @@ def test_a_failure_while_moving_into_place_is_undone(tmp_path, monkeypatch):
     write_output_folder(out, {"01.html": "one", "02.html": "two", "old.html": "old"},
                         tool="handouts")
     before = snapshot(tmp_path)
-    real_replace = os.replace
+    real_link = os.link
     calls = []
 
-    def replace(source, target, *args, **kwargs):
+    def link(source, target, *args, **kwargs):  # a new file is linked into place
         calls.append(target)
         if Path(target) == out / MANIFEST_NAME:  # the last move of the build
             raise OSError(errno.EIO, "Input/output error", str(target))
-        return real_replace(source, target, *args, **kwargs)
+        return real_link(source, target, *args, **kwargs)
 
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "link", link)
     with pytest.raises(OutputWriteError, match="Input/output error"):
         write_output_folder(out, {"01.html": "ONE", "02.html": "TWO", "new/03.html": "3"},
                             tool="handouts")

@@ -273,8 +273,7 @@ def test_the_recovery_never_overwrites_a_file_changed_after_the_kill(tmp_path, s
         harness(WRITE.format(out=str(out), files=OLD), 10**9)
         assert harness(WRITE.format(out=str(out), files=NEW), n).returncode == -9
         journal = out / ".lqe-journal.json"
-        if journal.exists() and '"committing"' in journal.read_text() and \
-                (out / "a.html").read_text() == "a, old":
+        if journal.exists() and (out / "a.html").read_text() == "a, old":
             break
     else:
         pytest.fail("no kill point between the journal and the first move")
@@ -292,13 +291,13 @@ def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
         import os, signal
         from lqe_helpers.authoring.output_folder import write_output_folder
         write_output_folder({str(out)!r}, {OLD!r}, tool="handouts")
-        real, calls = os.replace, []
-        def replace(*args, **kwargs):
+        real, calls = os.link, []
+        def link(*args, **kwargs):  # a new file linked into place
             calls.append(args)
-            if len(calls) == 4:
+            if len(calls) == 2:
                 signal.raise_signal(signal.SIGINT)  # Ctrl-C, between two moves
             return real(*args, **kwargs)
-        os.replace = replace
+        os.link = link
         try:
             write_output_folder({str(out)!r}, {NEW!r}, tool="handouts")
         except KeyboardInterrupt:
@@ -308,6 +307,6 @@ def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
                             capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("interrupted after")
-    assert int(result.stdout.split()[2]) > 4  # every move was made first
+    assert int(result.stdout.split()[2]) > 2  # every move was made first
     assert {name: data.decode() for name, data in snapshot(out).items()
             if isinstance(data, bytes) and name.endswith(".html")} == NEW

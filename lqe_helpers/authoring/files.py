@@ -6,7 +6,7 @@ Every byte the course tools write goes out through this module:
   the target's own folder, flushes it to disk and moves it over the target with
   :func:`os.replace`; on failure the target is untouched and the temporary file removed.
 - :func:`write_new_file` creates a file that must not exist yet (a build's staged copy);
-  :func:`link_or_copy` keeps a file's content under another name (a backup).
+  :func:`regular_file_bytes` reads a small regular file, refusing anything else unopened.
 - :func:`file_state` says what a file is now (size, modification time, SHA-256), so a
   tool can tell whether someone changed it since it was read.
 - A target that is a symbolic link is refused, never written through nor replaced
@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
 import stat
 import tempfile
 from dataclasses import dataclass
@@ -185,14 +184,6 @@ def write_new_file(path: Path, data: bytes, *, mode: int | None = None,
         _write_all(fd, data, path if named is None else named)
     finally:
         os.close(fd)
-
-
-def link_or_copy(source: Path, target: Path) -> None:
-    """Make ``target`` (new) hold ``source``'s content: a hard link, else a copy."""
-    try:
-        os.link(source, target, follow_symlinks=False)
-    except OSError:
-        shutil.copy2(source, target, follow_symlinks=False)
 
 
 def regular_file_bytes(path: Path, limit: int, what: str = "file") -> bytes:

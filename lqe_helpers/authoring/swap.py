@@ -3,13 +3,13 @@
 A swap (:func:`swap_in`, :func:`atomic_write_many`) in a folder:
 
 1. writes every new file into a temporary folder beside them, ``.lqe-build-<16 hex>/``
-   (``new/<name>``, with a hard link ``keep/<name>`` that proves later which files the
-   swap put in place), stamped with the tool's name;
+   (``new/<name>``, linked into place later, so it proves which files the swap placed),
+   stamped with the tool's name;
 2. writes the journal :data:`JOURNAL_NAME`: the temporary folder, every file to replace
    or create with the SHA-256 of its old and new content, every file to delete;
-3. renames the files into place (the old one kept aside as ``old/<name>``), deletes,
-   the manifest last; each target is compared with what the tool expects right before
-   its rename, and a file someone changed is never replaced;
+3. moves each old file aside (``old/<name>``), checks that what it moved is what the
+   tool expects, and links the new one in (which never overwrites a file saved
+   meanwhile); then deletes; the manifest last. A file someone changed is kept;
 4. removes the temporary folder, then the journal.
 
 A failure the process sees is undone at once (the journal says ``undo`` first). After
@@ -49,7 +49,6 @@ from lqe_helpers.authoring.files import (
     check_target,
     file_sha256,
     file_state,
-    link_or_copy,
     mode_for,
     regular_file_bytes,
     sha256,
@@ -215,57 +214,64 @@ def forward(folder: Path, journal: Journal,
             expected: Mapping[str, FileState] | None = None) -> tuple[int, list[str], list[str]]:
     """Make every move of the journal not made yet; return (moved, changed, missing).
 
-    A target that holds neither its old nor its new content (or, given ``expected``,
-    is not that :class:`FileState` right before its rename) was changed by someone: it
-    is kept (``changed``). A move whose new file is gone from the temporary folder
-    cannot be made (``missing``).
+    Each target is first renamed aside (``old/<name>``) and what was moved is compared
+    with the journal's old content (and ``expected``'s size, time and checksum): a file
+    someone changed, even a moment before, is put back and kept (``changed``). The new
+    file is then linked in, which fails rather than overwrite a file saved meanwhile.
+    A move whose new file is gone from the temporary folder cannot be made (``missing``).
     """
     staging = folder / journal.staging
     moved, changed, missing = 0, [], []
     for name, new, old in _order(journal):
-        target = folder / name
+        target, backup = folder / name, staging / "old" / name
         now = _content(target)
-        if now == new:
+        aside = now is None and old is not None and _kept(staging, "old", name) is not None \
+            and file_sha256(backup) == old  # moved aside by a killed run
+        if now == new and not aside:
             continue  # made already
-        if (now != old or (expected and name in expected
-                           and file_state(target) != expected[name])):
-            changed.append(name)
-            continue
         staged = _kept(staging, "new", name) if new else None
-        if new and staged is None:
-            missing.append(name)
+        if (now != old and not aside) or (new and staged is None):
+            (changed if staged or not new else missing).append(name)
             continue
-        if now is not None and _kept(staging, "old", name) is None:
-            (staging / "old" / name).parent.mkdir(parents=True, exist_ok=True)
+        if now is not None:
+            backup.parent.mkdir(parents=True, exist_ok=True)
             _step()
-            link_or_copy(target, staging / "old" / name)
-        target.parent.mkdir(parents=True, exist_ok=True)
-        _step()
-        if staged is None:
-            os.unlink(target)
-        else:
-            os.replace(staged, target)
+            os.replace(target, backup)
+            if file_sha256(backup) != old or (expected and name in expected
+                                              and file_state(backup) != expected[name]):
+                with contextlib.suppress(FileExistsError):
+                    os.link(backup, target)  # someone's edit: back in place, never over a newer
+                os.unlink(backup)
+                changed.append(name)
+                continue
+        if staged is not None:
+            target.parent.mkdir(parents=True, exist_ok=True)
+            _step()
+            try:
+                os.link(staged, target)
+            except FileExistsError:
+                changed.append(name)  # saved by someone while the old file was aside
+                continue
         moved += 1
     return moved, changed, missing
 
 
 def undo(folder: Path, journal: Journal) -> int:
     """Put back every old file of the journal; remove only files the swap itself put in
-    place (the same file as its ``keep/`` link). Return how many files were put back."""
+    place (the same file as its staged copy). Return how many files were put back."""
     staging = folder / journal.staging
     restored = 0
     for name, new, old in reversed(_order(journal)):
         target, backup = folder / name, _kept(staging, "old", name)
-        if new is None:
-            if not os.path.lexists(target) and backup and file_sha256(backup) == old:
-                _step()
-                os.replace(backup, target)
-                restored += 1
-        elif _same(target, _kept(staging, "keep", name)):
-            if old is None or (backup and file_sha256(backup) == old):
-                _step()
-                os.replace(backup, target) if backup else os.unlink(target)
-                restored += 1
+        placed = new is not None and _same(target, _kept(staging, "new", name))
+        if placed and old is None:
+            _step()
+            os.unlink(target)
+            restored += 1
+        elif (placed or not os.path.lexists(target)) and backup and file_sha256(backup) == old:
+            _step()
+            os.replace(backup, target)
+            restored += 1
     for name in reversed(journal.folders):
         with contextlib.suppress(OSError):
             (folder / name).rmdir()  # only if empty
@@ -432,11 +438,9 @@ def _stage(folder: Path, tool: str, writes: Mapping[str, bytes],
     write_new_file(staging / _STAMP, f"{tool}\n".encode())
     for name, data in writes.items():
         target = folder / name
-        for part in ("new", "keep"):
-            (staging / part / name).parent.mkdir(parents=True, exist_ok=True)
+        (staging / "new" / name).parent.mkdir(parents=True, exist_ok=True)
         _step()
         write_new_file(staging / "new" / name, data, mode=mode_for(target), named=target)
-        os.link(staging / "new" / name, staging / "keep" / name)
         journal.writes[name] = (sha256(data), file_sha256(target))
         journal.folders += [p.as_posix() for p in reversed(PurePosixPath(name).parents[:-1])
                             if p.as_posix() not in journal.folders and not (folder / p).exists()]
@@ -486,6 +490,7 @@ def swap_in(folder: Path, writes: Mapping[str, bytes], deletes: Mapping[str, str
         if changed:
             raise OutputFolderError(f"{_summarise(changed)} in {shown(folder)} changed while the "
                                     f"build ran; nothing was changed (run it again)")
+    with signals_deferred():  # done: an interrupt now leaves only tidying to the next run
         _finish(folder, journal, folder / journal.staging)
 
 
@@ -542,15 +547,15 @@ def atomic_write_many(files: Mapping[Path | str, bytes | str], *,
         for folder in sorted(groups):
             held.enter_context(FolderLock(folder))
         held.enter_context(signals_deferred())
-        held.enter_context(_undone_on_failure(swaps, "those folders"))
-        for folder, writes in groups.items():
-            _stage(folder, tool, writes, swaps)
-        for folder, journal in swaps:
-            _write_journal(folder, journal)
-            wanted = {name: states[folder, name] for name in journal.writes
-                      if (folder, name) in states}
-            _, changed, _ = forward(folder, journal, wanted)
-            kept.update((folder, name) for name in changed)
+        with _undone_on_failure(swaps, "those folders"):
+            for folder, writes in groups.items():
+                _stage(folder, tool, writes, swaps)
+            for folder, journal in swaps:
+                _write_journal(folder, journal)
+                wanted = {name: states[folder, name] for name in journal.writes
+                          if (folder, name) in states}
+                _, changed, _ = forward(folder, journal, wanted)
+                kept.update((folder, name) for name in changed)
         for folder, journal in swaps:
             _finish(folder, journal, folder / journal.staging)
     return [path for path in targets if (real[path], path.name) not in kept]
