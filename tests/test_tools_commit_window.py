@@ -18,7 +18,6 @@ from tools_helpers import code_notebook
 from lqe_helpers.authoring import notebook_runner
 from lqe_helpers.authoring.notebook_io import notebook_bytes, read_notebook
 
-
 REAL_RENAME = os.rename
 
 
