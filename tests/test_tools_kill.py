@@ -33,8 +33,7 @@ from tools_helpers import (
     write_notebook,
 )
 
-from lqe_helpers.authoring.swap import RecoveryWarning
-from lqe_helpers.authoring.swap import FolderLock
+from lqe_helpers.authoring.swap import FolderLock, RecoveryWarning
 
 #: Runs ``code`` with every file operation under the folder ``watched`` counted; SIGKILL
 #: (or KeyboardInterrupt) just before the ``N``-th.

@@ -33,7 +33,7 @@ import signal
 import threading
 import warnings
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path, PurePosixPath
 
 try:
@@ -45,7 +45,6 @@ from lqe_helpers.authoring.errors import summarise as _summarise
 from lqe_helpers.authoring.files import (
     FileState,
     as_bytes,
-    atomic_write_bytes,
     check_target,
     file_sha256,
     file_state,
@@ -54,7 +53,7 @@ from lqe_helpers.authoring.files import (
     sha256,
     write_new_file,
 )
-from lqe_helpers.authoring.manifest import MANIFEST_NAME, Manifest, entry_problem, read_manifest
+from lqe_helpers.authoring.manifest import MANIFEST_NAME, entry_problem, read_manifest
 
 #: The journal of a swap in progress, in the folder it writes.
 JOURNAL_NAME = ".lqe-journal.json"
@@ -94,11 +93,7 @@ class Journal:
 
     def to_bytes(self) -> bytes:
         """The journal file's content (JSON)."""
-        return json.dumps({"format": 2, "tool": self.tool, "staging": self.staging,
-                           "undo": self.undo, "writes": [[n, *v] for n, v in self.writes.items()],
-                           "deletes": [[n, v] for n, v in self.deletes.items()],
-                           "folders": self.folders},
-                          indent=1, ensure_ascii=False).encode("utf-8")
+        return json.dumps({"format": 2, **asdict(self)}, ensure_ascii=False).encode("utf-8")
 
 
 def _bad(folder: Path, why: str = "") -> OutputFolderError:
@@ -117,30 +112,25 @@ def read_journal(folder: Path) -> Journal | None:
         it is opened: a fifo never blocks), not a journal, or names a file outside
         ``folder`` or a temporary folder not of the pattern :data:`STAGING`.
     """
-    path = folder / JOURNAL_NAME
-    if not os.path.lexists(path):
+    if not os.path.lexists(folder / JOURNAL_NAME):
         return None
     try:
-        content = json.loads(regular_file_bytes(path, MAX_JOURNAL_BYTES).decode("utf-8"))
-        journal = Journal(content["tool"], content["staging"],
-                          {n: (new, old) for n, new, old in content["writes"]},
-                          {n: old for n, old in content["deletes"]}, content["undo"],
-                          content["folders"])
-        valid = (content["format"] == 2 and isinstance(journal.tool, str)
-                 and isinstance(journal.staging, str) and STAGING.fullmatch(journal.staging)
-                 and all(isinstance(v, str) for n, (new, _) in journal.writes.items()
-                         for v in (n, new))
-                 and all(isinstance(v, str | None) for _, old in journal.writes.values()
-                         for v in [old])
-                 and all(isinstance(v, str) for v in journal.deletes.values()))
-    except (OSError, UnicodeDecodeError, ValueError, KeyError, TypeError, RecursionError):
+        content = json.loads(regular_file_bytes(folder / JOURNAL_NAME, MAX_JOURNAL_BYTES))
+        journal = Journal(**{key: content[key] for key in Journal.__dataclass_fields__})
+        values = [journal.tool, journal.staging, *journal.folders, *journal.deletes.values(),
+                  *(new for new, _ in journal.writes.values())]
+        valid = (content["format"] == 2 and STAGING.fullmatch(journal.staging)
+                 and all(isinstance(value, str) for value in values)
+                 and all(isinstance(old, str | None) for _, old in journal.writes.values()))
+    except (OSError, ValueError, KeyError, TypeError, AttributeError, RecursionError):
         valid = False
     if not valid:
         raise _bad(folder)
     for name in [*journal.writes, *journal.deletes, *journal.folders]:
         problem = entry_problem(folder, name, manifest_ok=True)
         if problem:
-            raise OutputFolderError(f"{path} lists {name!r}, which is {problem}; nothing was "
+            raise OutputFolderError(f"{folder / JOURNAL_NAME} lists {name!r}, which is {problem}; "
+                                    f"nothing was "
                                     f"changed: move the folder {folder} away")
     return journal
 
@@ -152,12 +142,13 @@ def _check_against_manifest(folder: Path, journal: Journal) -> None:
             raise _bad(folder, " (it deletes files, but writes no manifest)")
         return
     new, old = journal.writes[MANIFEST_NAME]
-    now = _content(folder / MANIFEST_NAME)
+    now, staging = _content(folder / MANIFEST_NAME), folder / journal.staging
     if now == new or journal.undo:
         return  # every replace and delete was made (an undo checks each file it touches)
-    if now != old:
+    aside = now is None and _aside(staging, MANIFEST_NAME, old)
+    if now != old and not aside:
         raise _bad(folder, f" (it does not match the folder's {MANIFEST_NAME})")
-    listed = read_manifest(folder).files if old else {}
+    listed = read_manifest(staging / "old" if aside else folder).files if old else {}
     touched = {**{n: o for n, (_, o) in journal.writes.items() if o}, **journal.deletes}
     for name, digest in touched.items():
         if name != MANIFEST_NAME and listed.get(name) != digest:
@@ -194,6 +185,12 @@ def _kept(staging: Path, part: str, name: str) -> Path | None:
     return path
 
 
+def _aside(staging: Path, name: str, old: str | None) -> bool:
+    """Whether the old file ``name`` (SHA-256 ``old``) was moved aside into ``staging``."""
+    return old is not None and _kept(staging, "old", name) is not None \
+        and file_sha256(staging / "old" / name) == old
+
+
 def _same(first: Path, second: Path | None) -> bool:
     try:
         return second is not None and os.path.samefile(first, second)
@@ -225,8 +222,7 @@ def forward(folder: Path, journal: Journal,
     for name, new, old in _order(journal):
         target, backup = folder / name, staging / "old" / name
         now = _content(target)
-        aside = now is None and old is not None and _kept(staging, "old", name) is not None \
-            and file_sha256(backup) == old  # moved aside by a killed run
+        aside = now is None and _aside(staging, name, old)  # moved aside by a killed run
         if now == new and not aside:
             continue  # made already
         staged = _kept(staging, "new", name) if new else None
@@ -337,27 +333,14 @@ def recover(folder: Path) -> str | None:
 
 
 def _cannot_finish(folder: Path, journal: Journal, what: str, missing: list[str]) -> str:
-    """The temporary folder went mid-swap: say what is true; the manifest then lists, of
-    the files it listed, each with what it holds now (its old or its new content)."""
-    now = {name: _content(folder / name) for name in journal.writes}
-    written = [n for n, (new, _) in journal.writes.items() if n != MANIFEST_NAME and now[n] == new]
-    total = len(journal.writes) - (MANIFEST_NAME in journal.writes)
-    note = ""
-    if MANIFEST_NAME in journal.writes:
-        listed = (read_manifest(folder) or Manifest(journal.tool)).files
-        files = {n: now.get(n) or _content(folder / n) for n in listed}
-        files = {n: d for n, d in files.items()
-                 if d in (listed[n], journal.writes.get(n, ("",))[0])}
-        atomic_write_bytes(folder / MANIFEST_NAME, Manifest(journal.tool, files).to_bytes())
-        unlisted = [n for n in written if n not in listed]
-        note = f"; {MANIFEST_NAME} now lists each file it listed with what it holds" + (
-            f"; not listed (new, so not known to be the tool's): {_summarise(unlisted)}"
-            if unlisted else "")
+    """The temporary folder went mid-swap: remove the journal and say what is true."""
+    written = [n for n, (new, _) in journal.writes.items() if _content(folder / n) == new]
     _finish(folder, journal, folder / journal.staging)
     return (f"{what} while moving its files into place, and its temporary folder "
             f"{journal.staging} is gone, so that run can be neither finished nor undone: "
-            f"{len(written)} of {total} file(s) hold its new content, the others the earlier "
-            f"content ({len(missing)} move(s) lost){note}")
+            f"{len(written)} of {len(journal.writes)} file(s) (its manifest included) hold its "
+            f"new content, the others are as before ({len(missing)} move(s) lost); files no "
+            f"longer as the manifest lists them are kept and named by the next build")
 
 
 class FolderLock:
