@@ -19,8 +19,8 @@ from __future__ import annotations
 
 import hashlib
 import os
+import secrets
 import stat
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -43,38 +43,11 @@ def _write_fd(fd: int, data: bytes) -> None:
         view = view[written:]
 
 
-def umask() -> int:
-    """The process's umask (read by setting and restoring it)."""
-    current = os.umask(0)
-    os.umask(current)
-    return current
-
-
 def new_file_mode() -> int:
     """Permission bits of a new file under the current umask (``0o666 & ~umask``)."""
-    return 0o666 & ~umask()
-
-
-def _temporary_copy(path: Path, data: bytes) -> Path:
-    """Write ``data`` to a new temporary file beside ``path``; return its path.
-
-    The file gets the permission bits of ``path`` if it exists (else the umask's), and
-    is flushed to disk. On failure nothing is left behind.
-    """
-    try:
-        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-tmp")
-    except OSError as error:  # name the file being written, not a temporary name
-        raise OSError(error.errno, error.strerror, str(path)) from error
-    temporary = Path(name)
-    try:
-        os.fchmod(fd, mode_for(path))
-        _write_all(fd, data, path)
-    except BaseException:
-        os.close(fd)
-        temporary.unlink(missing_ok=True)
-        raise
-    os.close(fd)
-    return temporary
+    current = os.umask(0)
+    os.umask(current)
+    return 0o666 & ~current
 
 
 def mode_for(path: Path) -> int:
@@ -137,11 +110,14 @@ def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
     """
     path = Path(path)
     check_target(path)
-    temporary = _temporary_copy(path, data)
+    temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.lqe-tmp")
     try:
+        write_new_file(temporary, data, mode=mode_for(path), named=path)
         os.replace(temporary, path)
-    except BaseException:
+    except BaseException as error:
         temporary.unlink(missing_ok=True)
+        if isinstance(error, OSError) and error.filename == str(temporary):
+            raise OSError(error.errno, error.strerror, str(path)) from error  # not a temp name
         raise
     return path
 

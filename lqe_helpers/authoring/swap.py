@@ -463,18 +463,32 @@ def swap_in(folder: Path, writes: Mapping[str, bytes], deletes: Mapping[str, str
     OutputFolderError
         If a file changed since the caller looked (everything is then undone).
     """
+    _swap({folder: (writes, deletes, expected, {})}, tool, shown(folder), strict=True)
+
+
+def _swap(plans: Mapping[Path, tuple[Mapping[str, bytes], Mapping[str, str],
+                                     Mapping[str, str | None], Mapping[str, FileState]]],
+          tool: str, where: str, *, strict: bool) -> set[tuple[Path, str]]:
+    """Swap each folder's (writes, deletes, expected SHA-256s, expected states); every
+    folder is staged before the first rename. Return the (folder, name)s kept as changed
+    (``strict``: a changed file undoes everything instead)."""
     swaps: list[tuple[Path, Journal]] = []
-    with signals_deferred(), _undone_on_failure(swaps, shown(folder)):
-        journal = _stage(folder, tool, writes, swaps)
-        journal.writes.update({n: (journal.writes[n][0], old) for n, old in expected.items()})
-        journal.deletes = dict(deletes)
-        _write_journal(folder, journal)
-        _, changed, _ = forward(folder, journal)
-        if changed:
-            raise OutputFolderError(f"{_summarise(changed)} in {shown(folder)} changed while the "
-                                    f"build ran; nothing was changed (run it again)")
-    with signals_deferred():  # done: an interrupt now leaves only tidying to the next run
-        _finish(folder, journal, folder / journal.staging)
+    kept: set[tuple[Path, str]] = set()
+    with signals_deferred():
+        with _undone_on_failure(swaps, where):
+            for folder, (writes, deletes, expected, _) in plans.items():
+                journal = _stage(folder, tool, writes, swaps)
+                journal.writes.update({n: (journal.writes[n][0], o) for n, o in expected.items()})
+                journal.deletes = dict(deletes)
+            for folder, journal in swaps:
+                _write_journal(folder, journal)
+                kept.update((folder, n) for n in forward(folder, journal, plans[folder][3])[1])
+            if kept and strict:
+                raise OutputFolderError(f"{_summarise([n for _, n in kept])} in {where} changed "
+                                        f"while the build ran; nothing was changed (run it again)")
+        for folder, journal in swaps:  # done: an interrupt now leaves tidying to the next run
+            _finish(folder, journal, folder / journal.staging)
+    return kept
 
 
 @contextlib.contextmanager
@@ -522,23 +536,13 @@ def atomic_write_many(files: Mapping[Path | str, bytes | str], *,
     groups: dict[Path, dict[str, bytes]] = {}
     for path, data in targets.items():
         groups.setdefault(real[path], {})[path.name] = data
-    states = {(real[path], path.name): state for path, state in (expected or {}).items()
-              if state is not None}
-    kept: set[tuple[Path, str]] = set()
-    swaps: list[tuple[Path, Journal]] = []
+    states: dict[Path, dict[str, FileState]] = {}
+    for path, state in (expected or {}).items():
+        if state is not None:
+            states.setdefault(real[path], {})[path.name] = state
     with contextlib.ExitStack() as held:
         for folder in sorted(groups):
             held.enter_context(FolderLock(folder))
-        held.enter_context(signals_deferred())
-        with _undone_on_failure(swaps, "those folders"):
-            for folder, writes in groups.items():
-                _stage(folder, tool, writes, swaps)
-            for folder, journal in swaps:
-                _write_journal(folder, journal)
-                wanted = {name: states[folder, name] for name in journal.writes
-                          if (folder, name) in states}
-                _, changed, _ = forward(folder, journal, wanted)
-                kept.update((folder, name) for name in changed)
-        for folder, journal in swaps:
-            _finish(folder, journal, folder / journal.staging)
+        kept = _swap({folder: (writes, {}, {}, states.get(folder, {}))
+                      for folder, writes in groups.items()}, tool, "those folders", strict=False)
     return [path for path in targets if (real[path], path.name) not in kept]
