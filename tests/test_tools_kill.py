@@ -309,3 +309,30 @@ def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
     assert int(result.stdout.split()[2]) > 2  # every move was made first
     assert {name: data.decode() for name, data in snapshot(out).items()
             if isinstance(data, bytes) and name.endswith(".html")} == NEW
+
+
+@pytest.mark.slow
+def test_student_edition_killed_mid_move_is_recovered_before_the_folder_is_checked(tmp_path):
+    """Issue 27: each tool checked the folder before taking it (which recovers), so a kill
+    while the files moved made the next run refuse ("… was changed since student_edition
+    wrote it"). Killed at a spread of file operations (the harness counts the operating
+    system's, whatever the mechanism), the next command line run must succeed."""
+    source, out = tmp_path / "notebooks", tmp_path / "build" / "student"
+    for name in ("01_a.ipynb", "02_b.ipynb", "03_c.ipynb"):
+        write_notebook(source / name)
+    assert run_tool("student_edition", "--source", str(source), "--out", str(out)).returncode == 0
+    base = tmp_path.parent / f"{tmp_path.name}-base"
+    for name in ("01_a.ipynb", "02_b.ipynb"):
+        write_notebook(source / name, worked_notebook(solution=f"# Task: other.\nx = '{name}'"))
+    shutil.copytree(tmp_path, base)
+    code = ("from lqe_helpers.authoring.student_edition import main\n"
+            f"main(['--source', {str(source)!r}, '--out', {str(out)!r}])")
+    count = operations(code)
+    new = snapshot(out)
+    for n in range(count // 3, count, max(1, count // 8)):
+        shutil.rmtree(tmp_path)
+        shutil.copytree(base, tmp_path)
+        assert harness(code, n).returncode == -9
+        result = run_tool("student_edition", "--source", str(source), "--out", str(out))
+        assert result.returncode == 0, (n, result.stderr)
+        assert snapshot(out) == new, n

@@ -62,7 +62,7 @@ def setup_pack(work: Path, new: bool) -> list[str]:
     if not new:
         make_course(work / "course")
     else:
-        (work / "course" / "README.md").write_text("# The course\n\nRead me again.\n")
+        notebooks(work / "course" / "notebooks", ("01_first.ipynb",), "2")
     return ["--root", str(work / "course"), "--out", str(work / "out")]
 
 
