@@ -3,9 +3,8 @@
 ``python -m lqe_helpers.authoring.clean build/handouts build/student ...`` deletes, in each
 folder, the files listed in its manifest (``.lqe-manifest.json``) that still hold exactly
 what the tool wrote, then the manifest and the folders left empty. A file the tools did
-not write, or one changed since, is kept and named, and so is a folder named like a
-tool's temporary folder (``.lqe-build-…``) that no journal recorded. A build killed
-part-way is finished or undone first. A folder without a manifest, or whose manifest lists
+not write, or one changed since, is kept and named. A build killed part-way is finished
+or undone first, before the folder is read. A folder without a manifest, or whose manifest lists
 a name outside it, is left as it is (the latter with an ``error:`` line and exit status
 1). Needs only the standard library, so it runs even when ``.venv`` is broken.
 """
@@ -22,7 +21,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import OutputFolderError, error_line, shown, summarise
-    from lqe_helpers.authoring.manifest import MANIFEST_NAME, read_manifest
+    from lqe_helpers.authoring.manifest import MANIFEST_NAME
     from lqe_helpers.authoring.output_folder import remove_output_folder
 
 
@@ -47,14 +46,15 @@ def clean(folders: Sequence[Path | str]) -> tuple[list[str], list[str]]:
             report.append(f"kept {shown(folder)}: a file, not an output folder")
             continue
         try:
-            if read_manifest(folder) is None:
-                report.append(f"kept {shown(folder)}: it has no {MANIFEST_NAME}, so nothing in it "
-                              f"is known to be the tools' (delete it yourself if it is)")
-                continue
-            _, kept = remove_output_folder(folder)
+            result = remove_output_folder(folder)  # held and recovered first, then read
         except (OutputFolderError, OSError) as error:
             errors.append(error_line(error))
             continue
+        if result is None:
+            report.append(f"kept {shown(folder)}: it has no {MANIFEST_NAME}, so nothing in it "
+                          f"is known to be the tools' (delete it yourself if it is)")
+            continue
+        _, kept = result
         if kept:
             names = summarise([path.relative_to(folder).as_posix() for path in kept], 5)
             report.append(f"kept in {shown(folder)}: {names} (not written by the tools, or "

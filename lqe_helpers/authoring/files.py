@@ -6,7 +6,7 @@ Every byte the course tools write goes out through this module:
   the target's own folder, flushes it to disk and moves it over the target with
   :func:`os.replace`; on failure the target is untouched and the temporary file removed.
 - :func:`write_new_file` creates a file that must not exist yet (a build's staged copy);
-  :func:`link_or_copy` keeps a file's content under another name (a backup).
+  :func:`regular_file_bytes` reads a small regular file, refusing anything else unopened.
 - :func:`file_state` says what a file is now (size, modification time, SHA-256), so a
   tool can tell whether someone changed it since it was read.
 - A target that is a symbolic link is refused, never written through nor replaced
@@ -19,9 +19,8 @@ from __future__ import annotations
 
 import hashlib
 import os
-import shutil
+import secrets
 import stat
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,38 +43,11 @@ def _write_fd(fd: int, data: bytes) -> None:
         view = view[written:]
 
 
-def umask() -> int:
-    """The process's umask (read by setting and restoring it)."""
-    current = os.umask(0)
-    os.umask(current)
-    return current
-
-
 def new_file_mode() -> int:
     """Permission bits of a new file under the current umask (``0o666 & ~umask``)."""
-    return 0o666 & ~umask()
-
-
-def _temporary_copy(path: Path, data: bytes) -> Path:
-    """Write ``data`` to a new temporary file beside ``path``; return its path.
-
-    The file gets the permission bits of ``path`` if it exists (else the umask's), and
-    is flushed to disk. On failure nothing is left behind.
-    """
-    try:
-        fd, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".lqe-tmp")
-    except OSError as error:  # name the file being written, not a temporary name
-        raise OSError(error.errno, error.strerror, str(path)) from error
-    temporary = Path(name)
-    try:
-        os.fchmod(fd, mode_for(path))
-        _write_all(fd, data, path)
-    except BaseException:
-        os.close(fd)
-        temporary.unlink(missing_ok=True)
-        raise
-    os.close(fd)
-    return temporary
+    current = os.umask(0)
+    os.umask(current)
+    return 0o666 & ~current
 
 
 def mode_for(path: Path) -> int:
@@ -138,11 +110,14 @@ def atomic_write_bytes(path: Path | str, data: bytes) -> Path:
     """
     path = Path(path)
     check_target(path)
-    temporary = _temporary_copy(path, data)
+    temporary = path.with_name(f".{path.name}.{secrets.token_hex(4)}.lqe-tmp")
     try:
+        write_new_file(temporary, data, mode=mode_for(path), named=path)
         os.replace(temporary, path)
-    except BaseException:
+    except BaseException as error:
         temporary.unlink(missing_ok=True)
+        if isinstance(error, OSError) and error.filename == str(temporary):
+            raise OSError(error.errno, error.strerror, str(path)) from error  # not a temp name
         raise
     return path
 
@@ -187,12 +162,27 @@ def write_new_file(path: Path, data: bytes, *, mode: int | None = None,
         os.close(fd)
 
 
-def link_or_copy(source: Path, target: Path) -> None:
-    """Make ``target`` (new) hold ``source``'s content: a hard link, else a copy."""
-    try:
-        os.link(source, target, follow_symlinks=False)
-    except OSError:
-        shutil.copy2(source, target, follow_symlinks=False)
+def regular_file_bytes(path: Path, limit: int, what: str = "file") -> bytes:
+    """The content of the regular file ``path`` of at most ``limit`` bytes.
+
+    Checked before it is opened (a fifo or a device never blocks, a huge file is never
+    read) and opened without following a link.
+
+    Raises
+    ------
+    ValueError
+        Saying why: not a regular file, or larger than ``limit`` (a ``what``'s).
+    OSError
+        If it cannot be read.
+    """
+    status = os.lstat(path)
+    if not stat.S_ISREG(status.st_mode):
+        raise ValueError("not a regular file (a link, a folder, a fifo or a device)")
+    if status.st_size > limit:
+        raise ValueError(f"{status.st_size} bytes, more than a {what}'s {limit}")
+    fd = os.open(path, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0) | os.O_NONBLOCK)
+    with open(fd, "rb") as file:
+        return file.read(limit + 1)[:limit + 1]
 
 
 def sha256(data: bytes) -> str:

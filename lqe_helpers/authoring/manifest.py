@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
 from lqe_helpers.authoring.errors import OutputFolderError, shown
-from lqe_helpers.authoring.files import refuse_symlink
+from lqe_helpers.authoring.files import regular_file_bytes
 
 #: Name of the manifest a tool keeps in its output folder (a JSON file).
 MANIFEST_NAME = ".lqe-manifest.json"
@@ -28,7 +28,7 @@ MANIFEST_FORMAT = 1
 #: What a name in an output folder may not start with: the tools' own files and folders.
 RESERVED_PREFIX = ".lqe-"
 #: The largest manifest the tools read (bytes): one of thousands of files is < 1 MB.
-MAX_MANIFEST_BYTES = 64 * 2**20
+MAX_MANIFEST_BYTES = 4 * 2**20
 _SHA256 = re.compile(r"[0-9a-f]{64}")
 
 
@@ -126,16 +126,12 @@ def read_manifest(out_dir: Path | str) -> Manifest | None:
     path = out_dir / MANIFEST_NAME
     if not os.path.lexists(path):
         return None
-    refuse_symlink(path)
     unreadable = (f"{path} is not a manifest the course tools can read (%s); nothing was "
                   f"changed: move the folder {out_dir} away or write elsewhere")
     try:
-        size = os.path.getsize(path)
-        if size > MAX_MANIFEST_BYTES:
-            raise OutputFolderError(unreadable % f"{size} bytes, more than a manifest's "
-                                                 f"{MAX_MANIFEST_BYTES}")
-        content = json.loads(path.read_bytes().decode("utf-8"))
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError, RecursionError) as error:
+        content = json.loads(regular_file_bytes(path, MAX_MANIFEST_BYTES, "manifest")
+                             .decode("utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError, RecursionError) as error:
         reason = error.strerror if isinstance(error, OSError) else (
             "nested too deeply" if isinstance(error, RecursionError) else str(error))
         raise OutputFolderError(unreadable % reason) from error

@@ -10,14 +10,12 @@
   the build would have to replace that is not the tool's stops the build before
   anything is changed. A manifest entry that is not a plain relative path inside the
   folder stops it too.
-- All or nothing, even under a kill: the build is one
-  :class:`~lqe_helpers.authoring.transaction.Transaction` (staged, journalled, then
-  moved into place); a failure is undone at once, a killed build is finished or undone
-  by the next tool that takes the folder.
-- One tool at a time: the folder is held (:class:`~lqe_helpers.authoring.transaction.
+- All or nothing, even under a kill: the build is swapped in with renames
+  (:mod:`lqe_helpers.authoring.swap`); a failure is undone at once, a killed swap is
+  finished or undone by the next tool that takes the folder, before it checks it.
+- One tool at a time: the folder is held (:class:`~lqe_helpers.authoring.swap.
   FolderLock`) for the whole build (:func:`build_output_folder`).
-- :func:`remove_output_folder` deletes what a tool wrote (``make clean``), and no
-  temporary folder but those a journal recorded.
+- :func:`remove_output_folder` deletes what a tool wrote (``make clean``).
 """
 
 from __future__ import annotations
@@ -37,7 +35,7 @@ from lqe_helpers.authoring.manifest import (
     name_problem,
     read_manifest,
 )
-from lqe_helpers.authoring.transaction import FolderLock, commit
+from lqe_helpers.authoring.swap import FolderLock, swap_in
 
 
 def _ancestors(path: Path) -> list[Path]:
@@ -237,14 +235,14 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
 
 
 @contextlib.contextmanager
-def _held_folder(out_dir: Path) -> Iterator[bool]:
-    """Create ``out_dir`` if needed and hold it (:class:`FolderLock`); yield whether it was
-    created. A folder created here that is empty when the block fails is removed again."""
+def _held_folder(out_dir: Path) -> Iterator[None]:
+    """Create ``out_dir`` if needed and hold it (:class:`FolderLock`, which first recovers a
+    killed swap); a folder created here and empty when the block fails is removed again."""
     created = not out_dir.exists()
     out_dir.mkdir(parents=True, exist_ok=True)
     try:
         with FolderLock(out_dir):
-            yield created
+            yield
     except BaseException:
         if created:
             with contextlib.suppress(OSError):
@@ -256,12 +254,11 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
                         sources: Sequence[Path | str] = ()) -> list[Path]:
     """Write a whole build into ``out_dir``, all or nothing, touching only the tool's files.
 
-    Holds the folder (created if needed), checks (:func:`plan_output_folder`): a file in
-    the way that the tool did not write, or changed since, stops the build before
-    anything is written. Then every file (and the manifest, last) is moved into place
-    as one :class:`~lqe_helpers.authoring.transaction.Transaction`, and the files of an
-    earlier build that this one no longer writes are deleted. A failure undoes every
-    change; a kill is finished or undone by the next tool that takes the folder.
+    Holds the folder (created if needed; a swap killed there is recovered first), then
+    checks it (:func:`plan_output_folder`): a file in the way that the tool did not
+    write, or changed since, stops the build before anything is written. Then the files
+    and the manifest are swapped in and the files of an earlier build no longer written
+    deleted (:func:`~lqe_helpers.authoring.swap.swap_in`, all or nothing).
 
     Parameters
     ----------
@@ -295,10 +292,11 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
         with _held_folder(out_dir):
             plan = plan_output_folder(out_dir, contents, tool=tool, sources=sources)
             manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
-            expected: dict[str, str | None] = {name: None for name in plan.create}
-            expected.update({name: plan.ours[name] for name in (*plan.replace, *plan.delete)})
-            commit(out_dir, {**contents, MANIFEST_NAME: manifest.to_bytes()}, plan.delete,
-                   tool=tool, expected=expected)
+            expected = {**{name: None for name in plan.create},
+                        **{name: plan.ours[name] for name in plan.replace}}
+            swap_in(out_dir, {**contents, MANIFEST_NAME: manifest.to_bytes()},
+                    {name: plan.ours[name] for name in plan.delete}, tool=tool,
+                    expected=expected)
     except OSError as error:
         where = f" ({shown(error.filename)})" if error.filename else ""
         raise OutputWriteError(
@@ -310,24 +308,11 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
 def build_output_folder(out_dir: Path | str, names: Sequence[str],
                         build: Callable[[], Mapping[str, bytes | str]], *, tool: str,
                         sources: Sequence[Path | str] = ()) -> list[Path]:
-    """Check ``out_dir``, run ``build()``, write what it returns: every tool's one shape.
+    """Hold and check ``out_dir``, run ``build()``, write what it returns: every tool's shape.
 
-    The folder is checked for ``names`` before the (perhaps long) build, and held for
-    the whole of it if it exists already, so a second tool on it stops at once; then
-    :func:`write_output_folder` writes the files ``build`` returns.
-
-    Parameters
-    ----------
-    out_dir : Path or str
-        The output folder.
-    names : sequence of str
-        The files the build will write (checked before ``build`` runs).
-    build : callable
-        Reads the sources and returns relative path → content.
-    tool : str
-        The tool's name (in the manifest).
-    sources : sequence of Path or str
-        The folders the build reads, which ``out_dir`` must not overlap.
+    An existing folder is held (and a killed swap there recovered) *before* it is checked
+    for ``names``, and for the whole (perhaps long) build, so a second tool on it stops
+    at once; then :func:`write_output_folder` writes the files ``build`` returns.
 
     Returns
     -------
@@ -335,36 +320,25 @@ def build_output_folder(out_dir: Path | str, names: Sequence[str],
         The written files, in the order ``build`` returned them.
     """
     out_dir = Path(out_dir)
-    plan_output_folder(out_dir, names, tool=tool, sources=sources)
-    held = FolderLock(out_dir) if out_dir.is_dir() else contextlib.nullcontext()
-    with held:
+    check_output_names(names)
+    check_output_location(out_dir, sources)
+    with FolderLock(out_dir) if out_dir.is_dir() else contextlib.nullcontext():
         plan_output_folder(out_dir, names, tool=tool, sources=sources)
-        files = build()
-        return write_output_folder(out_dir, files, tool=tool, sources=sources)
+        return write_output_folder(out_dir, build(), tool=tool, sources=sources)
 
 
-def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
+def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]] | None:
     """Delete what a tool wrote in ``out_dir`` (per its manifest); the folder too if then empty.
 
-    The folder is held (:class:`~lqe_helpers.authoring.transaction.FolderLock`), so a
-    build killed part-way is first finished or undone from its journal. Then only files
-    listed in the manifest that still hold exactly what the tool wrote are deleted, then
-    the manifest and the sub-folders of listed files (and ``out_dir``) that are left
-    empty. Everything else stays, including a folder named like a tool's temporary
-    folder (``.lqe-build-…``) that no journal recorded. A folder without a manifest is
-    left alone entirely, and so is one whose manifest lists a name outside it.
-
-    Parameters
-    ----------
-    out_dir : Path or str
-        A tool's output folder (nothing happens if it does not exist).
+    The folder is held and a swap killed there recovered first. Then only files listed
+    in the manifest that still hold exactly what the tool wrote are deleted, then the
+    manifest and the sub-folders of listed files (and ``out_dir``) left empty.
 
     Returns
     -------
-    removed : list of Path
-        The deleted files.
-    kept : list of Path
-        The files left in ``out_dir`` (not the tool's, or changed since it wrote them).
+    tuple of (list of Path, list of Path) or None
+        The deleted files and the files left in ``out_dir``; ``None`` (nothing touched)
+        if ``out_dir`` holds no manifest.
 
     Raises
     ------
@@ -373,26 +347,24 @@ def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]]:
         nothing is deleted then.
     """
     out_dir = Path(out_dir)
-    if not out_dir.is_dir():
-        return [], []
     removed: list[Path] = []
     with FolderLock(out_dir):
         manifest = read_manifest(out_dir)
-        if manifest is not None:
-            folders: set[Path] = set()
-            for name, digest in sorted(manifest.files.items()):
-                path = out_dir / name
-                folders.update(out_dir / parent for parent in PurePosixPath(name).parents[:-1])
-                if file_sha256(path) == digest:
-                    path.unlink()
-                    removed.append(path)
-            (out_dir / MANIFEST_NAME).unlink()
-            for folder in sorted(folders, key=lambda path: len(path.parts), reverse=True):
-                if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
-                    folder.rmdir()
-    if manifest is not None and not out_dir.is_symlink() and not any(out_dir.iterdir()):
+        if manifest is None:
+            return None
+        folders: set[Path] = set()
+        for name, digest in sorted(manifest.files.items()):
+            path = out_dir / name
+            folders.update(out_dir / parent for parent in PurePosixPath(name).parents[:-1])
+            if file_sha256(path) == digest:
+                path.unlink()
+                removed.append(path)
+        (out_dir / MANIFEST_NAME).unlink()
+        for folder in sorted(folders, key=lambda path: len(path.parts), reverse=True):
+            if folder.is_dir() and not folder.is_symlink() and not any(folder.iterdir()):
+                folder.rmdir()
+    if not out_dir.is_symlink() and not any(out_dir.iterdir()):
         out_dir.rmdir()
     kept = sorted(path for path in out_dir.rglob("*") if not path.is_dir()) \
         if out_dir.exists() else []
     return removed, kept
-

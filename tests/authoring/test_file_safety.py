@@ -19,7 +19,7 @@ import pytest
 from nbformat.v4 import new_code_cell, new_notebook
 from tools_helpers import snapshot
 
-from lqe_helpers.authoring import command_line, files, manifest, notebook_io, transaction
+from lqe_helpers.authoring import command_line, files, manifest, notebook_io, swap
 from lqe_helpers.authoring.errors import (
     FileSafetyError,
     NotebookFileError,
@@ -92,25 +92,25 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
     # A full disk while the second is being written: nothing replaced yet.
     monkeypatch.setattr(files, "_write_fd", full_disk_after(3))
     with pytest.raises(OSError):
-        transaction.atomic_write_many({first: "good after", second: "other after"})
+        swap.atomic_write_many({first: "good after", second: "other after"})
     assert snapshot(tmp_path) == before
     monkeypatch.undo()
 
     # The second move fails after the first one was made: the first is put back.
-    real_replace = os.replace
+    real_link = os.link
 
-    def replace(source, target, *args, **kwargs):
+    def link(source, target, *args, **kwargs):  # a new file is linked into place
         if Path(target) == second:
             raise OSError(errno.EACCES, "Permission denied", str(target))
-        return real_replace(source, target, *args, **kwargs)
+        return real_link(source, target, *args, **kwargs)
 
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "link", link)
     with pytest.raises(OSError):
-        transaction.atomic_write_many({first: "good after", second: "other after"})
+        swap.atomic_write_many({first: "good after", second: "other after"})
     monkeypatch.undo()
     assert snapshot(tmp_path) == before
 
-    assert transaction.atomic_write_many({first: "good after",
+    assert swap.atomic_write_many({first: "good after",
                                           second: b"other after"}) == [first, second]
     assert (first.read_text(), second.read_text()) == ("good after", "other after")
     assert sorted(os.listdir(tmp_path)) == ["good.ipynb", "other.ipynb"]
@@ -301,16 +301,16 @@ def test_a_failure_while_moving_into_place_is_undone(tmp_path, monkeypatch):
     write_output_folder(out, {"01.html": "one", "02.html": "two", "old.html": "old"},
                         tool="handouts")
     before = snapshot(tmp_path)
-    real_replace = os.replace
+    real_link = os.link
     calls = []
 
-    def replace(source, target, *args, **kwargs):
+    def link(source, target, *args, **kwargs):  # a new file is linked into place
         calls.append(target)
         if Path(target) == out / MANIFEST_NAME:  # the last move of the build
             raise OSError(errno.EIO, "Input/output error", str(target))
-        return real_replace(source, target, *args, **kwargs)
+        return real_link(source, target, *args, **kwargs)
 
-    monkeypatch.setattr(os, "replace", replace)
+    monkeypatch.setattr(os, "link", link)
     with pytest.raises(OutputWriteError, match="Input/output error"):
         write_output_folder(out, {"01.html": "ONE", "02.html": "TWO", "new/03.html": "3"},
                             tool="handouts")
@@ -323,14 +323,14 @@ def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
     out = tmp_path / "out"
     write_output_folder(out, {"01.html": "one"}, tool="handouts")
     before = snapshot(tmp_path)
-    real_mkstemp = files.tempfile.mkstemp
+    real_mkdir = os.mkdir
 
-    def read_only(*args, dir=None, **kwargs):  # the first file a build creates in out
-        if Path(dir) == out:
+    def read_only(path, *args, **kwargs):  # the first thing a build creates in out
+        if Path(path).parent == out:
             raise OSError(errno.EROFS, "Read-only file system", str(out))
-        return real_mkstemp(*args, dir=dir, **kwargs)
+        return real_mkdir(path, *args, **kwargs)
 
-    monkeypatch.setattr(files.tempfile, "mkstemp", read_only)
+    monkeypatch.setattr(os, "mkdir", read_only)
     with pytest.raises(OutputWriteError, match=f"cannot write into {out}: Read-only file system"):
         write_output_folder(out, {"01.html": "ONE"}, tool="handouts")
     assert snapshot(tmp_path) == before

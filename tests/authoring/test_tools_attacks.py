@@ -7,15 +7,19 @@ time limit near the largest float, ``--out`` at the home folder.
 
 from __future__ import annotations
 
+import hashlib
 import json
 import os
 import resource
+import stat
 import subprocess
+import warnings
 from pathlib import Path
 
 import pytest
 from tools_helpers import (
     MANIFEST,
+    error_lines,
     python_command,
     run_tool,
     snapshot,
@@ -24,35 +28,107 @@ from tools_helpers import (
 )
 
 from lqe_helpers.authoring.errors import OutputFolderError
-from lqe_helpers.authoring.journal import JOURNAL_NAME, RecoveryWarning
 from lqe_helpers.authoring.output_folder import write_output_folder
-from lqe_helpers.authoring.transaction import FolderLock
+from lqe_helpers.authoring.swap import JOURNAL_NAME, FolderLock, RecoveryWarning
 
 
-def journal(state: str, staging: str, steps: list, folders: list | None = None) -> str:
-    return json.dumps({"format": 1, "tool": "handouts", "state": state, "staging": staging,
-                       "folders": folders or [], "steps": steps})
+def journal(staging: str, writes: list | None = None, deletes: list | None = None, *,
+            undo: bool = False) -> str:
+    return json.dumps({"format": 2, "tool": "handouts", "staging": staging, "undo": undo,
+                       "writes": {name: [new, old] for name, new, old in writes or []},
+                       "deletes": dict(deletes or []), "folders": []})
+
+
+STAGING = ".lqe-build-00000000000000ff"
+
+
+def sha(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
 
 
 # --- a forged journal ---------------------------------------------------------------------------
 
 @pytest.mark.parametrize(("content", "said"), [
-    (journal("committing", ".lqe-build-x", [["../outside.txt", None, "0" * 64]]),
-     "lists '../outside.txt'"),
-    (journal("committing", "../..", []), "is not a journal"),
-    (journal("staging", ".lqe-build-x/../..", []), "is not a journal"),
-    (journal("undo-everything", ".lqe-build-x", []), "is not a journal"),
+    (journal(STAGING, [["../outside.txt", "0" * 64, None]]), "lists '../outside.txt'"),
+    (journal("../.."), "is not a journal"),
+    (journal(".lqe-build-x/../.."), "is not a journal"),
+    (journal(".lqe-build-mine"), "is not a journal"),  # a user's folder named like ours
+    (json.dumps({"format": 1, "tool": "handouts", "state": "committing",
+                 "staging": STAGING, "folders": [], "steps": []}), "is not a journal"),
     ("{not json", "is not a journal"),
 ])
 def test_a_forged_journal_touches_nothing(tmp_path, content, said):
     out = tmp_path / "out"
     write_output_folder(out, {"a.html": "a"}, tool="handouts")
     (tmp_path / "outside.txt").write_text("someone's file")
+    (out / ".lqe-build-mine").mkdir()
+    (out / ".lqe-build-mine" / "draft.txt").write_text("the instructor's draft")
     (out / JOURNAL_NAME).write_text(content)
     before = snapshot(tmp_path)
     with pytest.raises(OutputFolderError, match=said):
         write_output_folder(out, {"a.html": "b"}, tool="handouts")
     assert snapshot(tmp_path) == before
+
+
+def test_a_forged_delete_of_a_file_not_in_the_manifest_deletes_nothing(tmp_path):
+    """Issue 26: a forged delete step made student_edition delete a user's file."""
+    out = tmp_path / "out"
+    write_output_folder(out, {"a.html": "a"}, tool="handouts")
+    (out / "mine.txt").write_text("the instructor's notes")
+    manifest = (out / MANIFEST).read_bytes()
+    (out / JOURNAL_NAME).write_text(journal(
+        STAGING, [[MANIFEST, "1" * 64, sha(manifest)]],
+        [["mine.txt", sha(b"the instructor's notes")]]))
+    before = snapshot(out)
+    write_notebook(tmp_path / "notebooks" / "01_a.ipynb")
+    result = run_tool("student_edition", "--source", str(tmp_path / "notebooks"), "--out",
+                      str(out))
+    assert result.returncode == 1
+    assert error_lines(result.stderr) == [
+        f"error: {out / JOURNAL_NAME} names 'mine.txt', which {MANIFEST} does not list as the "
+        f"tool's; nothing was changed: move the folder {out} away"]
+    assert snapshot(out) == before
+    (out / JOURNAL_NAME).write_text(journal(STAGING, [], [["mine.txt", sha(b"x")]]))
+    with pytest.raises(OutputFolderError, match="it deletes files, but writes no manifest"):
+        write_output_folder(out, {"a.html": "b"}, tool="handouts")
+    assert (out / "mine.txt").read_text() == "the instructor's notes"
+
+
+def test_a_forged_undo_removes_only_files_the_swap_put_there(tmp_path):
+    """An undo removes a created file only if it is the very file the swap staged (its
+    ``keep/`` link), so a forged journal cannot make it remove a user's file."""
+    out = tmp_path / "out"
+    write_output_folder(out, {"a.html": "a"}, tool="handouts")
+    (out / "mine.txt").write_text("mine")
+    staging = out / STAGING
+    (staging / "keep").mkdir(parents=True)
+    (staging / "made-by").write_text("handouts\n")
+    (staging / "keep" / "mine.txt").write_text("mine")  # same content, another file
+    (out / JOURNAL_NAME).write_text(journal(STAGING, [["mine.txt", sha(b"mine"), None]],
+                                            undo=True))
+    with pytest.warns(RecoveryWarning, match=r"it is now undone \(0 file\(s\) put back\)"), \
+            FolderLock(out):
+        pass
+    assert (out / "mine.txt").read_text() == "mine"
+    assert sorted(path.name for path in out.iterdir()) == [MANIFEST, "a.html", "mine.txt"]
+
+
+def test_user_files_named_like_the_tools_temporary_files_are_kept(tmp_path):
+    """Issue 26: the recovery's glob deleted a user file named like a journal temp file."""
+    out = tmp_path / "out"
+    write_output_folder(out, {"a.html": "a"}, tool="handouts")
+    for name in (f".{JOURNAL_NAME}.abc.lqe-tmp", ".lqe-build-0123456789abcdef"):
+        (out / name).mkdir() if "build" in name else (out / name).write_text("mine")
+    (out / ".lqe-build-0123456789abcdef" / "x.txt").write_text("mine")  # no stamp
+    before = snapshot(out)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with FolderLock(out):
+            pass
+    write_output_folder(out, {"a.html": "b"}, tool="handouts")
+    assert {k: v for k, v in snapshot(out).items() if k.startswith(".lqe-build") or
+            k.endswith("lqe-tmp")} == {k: v for k, v in before.items()
+                                        if k.startswith(".lqe-build") or k.endswith("lqe-tmp")}
 
 
 def test_a_staging_folder_reached_through_a_link_is_never_followed(tmp_path):
@@ -62,17 +138,42 @@ def test_a_staging_folder_reached_through_a_link_is_never_followed(tmp_path):
     elsewhere = tmp_path / "home"
     elsewhere.mkdir()
     (elsewhere / "thesis.tex").write_text("three years of work")
-    staging = out / ".lqe-build-forged"
+    staging = out / STAGING
     staging.mkdir()
+    (staging / "made-by").write_text("handouts\n")
     (staging / "new").symlink_to(elsewhere)
-    digest = "1" * 64
-    (out / JOURNAL_NAME).write_text(journal("committing", staging.name,
-                                            [["thesis.tex", digest, None]]))
-    with pytest.warns(RecoveryWarning, match=r"\(0 more file\(s\) moved\)"), FolderLock(out):
+    (out / JOURNAL_NAME).write_text(journal(STAGING, [["thesis.tex", "1" * 64, None]]))
+    with pytest.warns(RecoveryWarning, match=r"0 of 1 file\(s\) \(its manifest included\) hold"), \
+            FolderLock(out):
         pass  # taking the folder recovers it
     assert (elsewhere / "thesis.tex").read_text() == "three years of work"
     assert not (out / "thesis.tex").exists()
     assert not (out / JOURNAL_NAME).exists()
+    assert not os.path.lexists(staging)
+
+
+@pytest.mark.parametrize(("tool", "name"), [
+    ("clean", MANIFEST), ("clean", JOURNAL_NAME), ("student_edition", MANIFEST),
+    ("student_edition", JOURNAL_NAME),
+    pytest.param("notebook_runner", JOURNAL_NAME, marks=pytest.mark.slow)])
+def test_a_fifo_named_like_the_tools_files_never_blocks(tmp_path, tool, name):
+    """Issue 27: a fifo named .lqe-manifest.json or .lqe-journal.json blocked these tools."""
+    source = tmp_path / "notebooks"
+    path = write_notebook(source / "01_a.ipynb")
+    out = source if tool == "notebook_runner" else tmp_path / "out"
+    if tool != "notebook_runner":
+        write_output_folder(out, {"01_a.ipynb": "x"}, tool="student_edition")
+        (out / name).unlink(missing_ok=True)
+    else:
+        out.mkdir(exist_ok=True)
+    os.mkfifo(out / name)
+    args = {"clean": [str(out)], "notebook_runner": [str(path)],
+            "student_edition": ["--source", str(source), "--out", str(out)]}[tool]
+    result = run_tool(tool, *args, timeout=60)
+    assert result.returncode == 1
+    [line] = error_lines(result.stderr)
+    assert "not a regular file" in line or "is not a journal" in line, line
+    assert stat.S_ISFIFO(os.lstat(out / name).st_mode)
 
 
 @pytest.mark.parametrize("kind", ["folder", "link", "huge"])
@@ -83,7 +184,7 @@ def test_an_odd_journal_file_is_one_line(tmp_path, kind):
     if kind == "folder":
         path.mkdir()
     elif kind == "link":
-        (tmp_path / "journal.json").write_text(journal("staging", ".lqe-build-x", []))
+        (tmp_path / "journal.json").write_text(journal(STAGING))
         path.symlink_to(tmp_path / "journal.json")
     else:
         with open(path, "wb") as file:

@@ -33,8 +33,7 @@ from tools_helpers import (
     write_notebook,
 )
 
-from lqe_helpers.authoring.journal import RecoveryWarning
-from lqe_helpers.authoring.transaction import FolderLock
+from lqe_helpers.authoring.swap import FolderLock, RecoveryWarning
 
 #: Runs ``code`` with every file operation under the folder ``watched`` counted; SIGKILL
 #: (or KeyboardInterrupt) just before the ``N``-th.
@@ -222,7 +221,7 @@ def test_atomic_write_many_killed_at_every_step(tmp_path):
     old = snapshot(tmp_path)
     files = {str(folder / name): f"{name} new" for folder in (first, second)
              for name in ("01.ipynb", "02.ipynb")}
-    code = ("from lqe_helpers.authoring.transaction import atomic_write_many\n"
+    code = ("from lqe_helpers.authoring.swap import atomic_write_many\n"
             f"atomic_write_many({files!r})")
     probe = tmp_path.parent / f"{tmp_path.name}-probe"
     shutil.copytree(tmp_path, probe)
@@ -273,8 +272,7 @@ def test_the_recovery_never_overwrites_a_file_changed_after_the_kill(tmp_path, s
         harness(WRITE.format(out=str(out), files=OLD), 10**9)
         assert harness(WRITE.format(out=str(out), files=NEW), n).returncode == -9
         journal = out / ".lqe-journal.json"
-        if journal.exists() and '"committing"' in journal.read_text() and \
-                (out / "a.html").read_text() == "a, old":
+        if journal.exists() and (out / "a.html").read_text() == "a, old":
             break
     else:
         pytest.fail("no kill point between the journal and the first move")
@@ -292,13 +290,13 @@ def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
         import os, signal
         from lqe_helpers.authoring.output_folder import write_output_folder
         write_output_folder({str(out)!r}, {OLD!r}, tool="handouts")
-        real, calls = os.replace, []
-        def replace(*args, **kwargs):
+        real, calls = os.link, []
+        def link(*args, **kwargs):  # a new file linked into place
             calls.append(args)
-            if len(calls) == 4:
+            if len(calls) == 2:
                 signal.raise_signal(signal.SIGINT)  # Ctrl-C, between two moves
             return real(*args, **kwargs)
-        os.replace = replace
+        os.link = link
         try:
             write_output_folder({str(out)!r}, {NEW!r}, tool="handouts")
         except KeyboardInterrupt:
@@ -308,6 +306,33 @@ def test_ctrl_c_while_the_files_are_moved_is_held_until_the_move_ends(tmp_path):
                             capture_output=True, text=True, timeout=120, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.startswith("interrupted after")
-    assert int(result.stdout.split()[2]) > 4  # every move was made first
+    assert int(result.stdout.split()[2]) > 2  # every move was made first
     assert {name: data.decode() for name, data in snapshot(out).items()
             if isinstance(data, bytes) and name.endswith(".html")} == NEW
+
+
+@pytest.mark.slow
+def test_student_edition_killed_mid_move_is_recovered_before_the_folder_is_checked(tmp_path):
+    """Issue 27: each tool checked the folder before taking it (which recovers), so a kill
+    while the files moved made the next run refuse ("… was changed since student_edition
+    wrote it"). Killed at a spread of file operations (the harness counts the operating
+    system's, whatever the mechanism), the next command line run must succeed."""
+    source, out = tmp_path / "notebooks", tmp_path / "build" / "student"
+    for name in ("01_a.ipynb", "02_b.ipynb", "03_c.ipynb"):
+        write_notebook(source / name)
+    assert run_tool("student_edition", "--source", str(source), "--out", str(out)).returncode == 0
+    base = tmp_path.parent / f"{tmp_path.name}-base"
+    for name in ("01_a.ipynb", "02_b.ipynb"):
+        write_notebook(source / name, worked_notebook(solution=f"# Task: other.\nx = '{name}'"))
+    shutil.copytree(tmp_path, base)
+    code = ("from lqe_helpers.authoring.student_edition import main\n"
+            f"main(['--source', {str(source)!r}, '--out', {str(out)!r}])")
+    count = operations(code)
+    new = snapshot(out)
+    for n in range(count // 3, count, max(1, count // 8)):
+        shutil.rmtree(tmp_path)
+        shutil.copytree(base, tmp_path)
+        assert harness(code, n).returncode == -9
+        result = run_tool("student_edition", "--source", str(source), "--out", str(out))
+        assert result.returncode == 0, (n, result.stderr)
+        assert snapshot(out) == new, n
