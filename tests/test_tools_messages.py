@@ -1,9 +1,10 @@
 """One line, naming the thing: the tools' messages under attack.
 
-Issue 19: Ctrl-C while a tool was still importing printed a traceback; a non-UTF-8 file
-in the student pack, a deeply nested notebook and ``File too large`` (``ulimit -f``)
-named no file; one error line repeated the same sentence 171 times (the handouts build,
-when its folder holds a MathJax copy it did not write: one sentence per MathJax file).
+Issue 19: Ctrl-C while a tool was still importing printed a traceback (issue 27: SIGTERM
+then printed nothing); a non-UTF-8 file in the student pack, a deeply nested notebook and
+``File too large`` (``ulimit -f``) named no file; one error line repeated the same
+sentence 171 times (the handouts build, when its folder holds a MathJax copy it did not
+write: one sentence per MathJax file).
 """
 
 from __future__ import annotations
@@ -49,8 +50,10 @@ SLOW_IMPORT = textwrap.dedent("""
 """)
 
 
+@pytest.mark.parametrize(("how", "status", "said"), [
+    (signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "stopped by SIGTERM")])
 @pytest.mark.parametrize("tool", TOOLS)
-def test_ctrl_c_while_a_tool_is_importing_is_one_line(tmp_path, tool):
+def test_a_signal_while_a_tool_is_importing_is_one_line(tmp_path, tool, how, status, said):
     hooks = tmp_path / "hooks"
     hooks.mkdir()
     (hooks / "sitecustomize.py").write_text(SLOW_IMPORT)
@@ -65,10 +68,10 @@ def test_ctrl_c_while_a_tool_is_importing_is_one_line(tmp_path, tool):
     while not importing.exists():
         assert time.monotonic() < end and process.poll() is None, process.communicate()
         time.sleep(0.05)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(how)
     out, err = process.communicate(timeout=60)
-    assert err == "error: interrupted while starting; nothing was done\n", err
-    assert process.returncode == 130
+    assert err == f"error: {said} while starting; nothing was done\n", err
+    assert process.returncode == status
     assert out == ""
 
 
