@@ -9,7 +9,9 @@ write: one sentence per MathJax file).
 
 from __future__ import annotations
 
+import os
 import resource
+import shutil
 import signal
 import subprocess
 import textwrap
@@ -86,6 +88,23 @@ def test_a_non_utf8_file_in_the_pack_is_named(tmp_path, where):
     with pytest.raises(ValueError) as raised:
         student_pack.build_student_pack(course, tmp_path / "out")
     assert error_line(raised.value).startswith(f"{path} is not UTF-8 text (invalid")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("folder", ["lqe_helpers", "notebooks"])
+def test_a_file_name_that_is_not_utf8_is_named_escaped(tmp_path, capsys, folder):
+    """Issue 27: the pack said only "'utf-8' codec can't encode character '\\udce9'"."""
+    course = make_course(tmp_path / "course")
+    name = os.fsdecode(b"caf\xe9.py" if folder == "lqe_helpers" else b"02_caf\xe9.ipynb")
+    shutil.copy(course / "notebooks" / "01_first.ipynb", course / folder / name)
+    assert student_pack.main(["--root", str(course), "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"error: '{course / folder}/caf\\udce9.py': its name is not UTF-8; the "
+                   f"student pack (a zip) names its files in UTF-8: rename it\n"
+                   if folder == "lqe_helpers" else
+                   f"error: '{course / folder}/02_caf\\udce9.ipynb': its name is not UTF-8; "
+                   f"the student pack (a zip) names its files in UTF-8: rename it\n"), err
+    assert err.isascii()
     assert not (tmp_path / "out").exists()
 
 
