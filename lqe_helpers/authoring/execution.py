@@ -63,13 +63,18 @@ class NotebookRunError(ToolError, RuntimeError):
 def positive_seconds(text: str) -> float:
     """``--timeout``'s type: a number of seconds > 0 and at most :data:`MAX_TIMEOUT`."""
     try:
-        value = float(text)
+        return _checked_timeout(float(text))
     except ValueError:
-        value = float("nan")
-    if not 0 < value <= MAX_TIMEOUT:
         raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r} (at "
-                                         f"most {MAX_TIMEOUT}, a week)")
-    return value
+                                         f"most {MAX_TIMEOUT}, a week)") from None
+
+
+def _checked_timeout(timeout: object) -> float:
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
+            or not 0 < timeout <= MAX_TIMEOUT:
+        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r} (at most "
+                         f"{MAX_TIMEOUT}, a week)")
+    return timeout
 
 
 def cell_label(notebook: nbformat.NotebookNode, index: int | None) -> str:
@@ -107,25 +112,21 @@ def merge_streams(outputs: list[Any]) -> list[Any]:
     output does not make two runs of the same notebook differ.
     """
     merged: list[Any] = []
-    pieces: dict[str, list[str]] = {}
-    first: dict[str, Any] = {}
+    streams: dict[str, tuple[Any, list[str]]] = {}  # name: its first output, its pieces
     for output in outputs:
-        if output.get("output_type") == "stream":
-            name = output["name"]
-            if name not in first:
-                first[name] = output
-                pieces[name] = []
-                merged.append(output)
-            pieces[name].append(output["text"])
-        else:
+        if output.get("output_type") != "stream":
             merged.append(output)
-    for name, output in first.items():
-        output["text"] = without_overwritten_text("".join(pieces[name]))
-    for index, output in enumerate(merged):  # as nbclient orders the two streams
-        if output["output_type"] == "stream" and output["name"] == "stderr" and (
-                len(merged) >= index + 2 and merged[index + 1]["output_type"] == "stream"
-                and merged[index + 1]["name"] == "stdout"):
-            merged.insert(index, merged.pop(index + 1))
+        elif output["name"] in streams:
+            streams[output["name"]][1].append(output["text"])
+        else:
+            streams[output["name"]] = (output, [output["text"]])
+            merged.append(output)
+    for output, pieces in streams.values():
+        output["text"] = without_overwritten_text("".join(pieces))
+    if {"stderr", "stdout"} <= streams.keys():  # stderr right before stdout: after it
+        place = next(i for i, output in enumerate(merged) if output is streams["stderr"][0])
+        if place + 1 < len(merged) and merged[place + 1] is streams["stdout"][0]:
+            merged[place:place + 2] = merged[place + 1], merged[place]
     return merged
 
 
@@ -193,10 +194,7 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
     ValueError
         If ``timeout`` is not a number of seconds > 0 and at most :data:`MAX_TIMEOUT`.
     """
-    if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
-            or not 0 < timeout <= MAX_TIMEOUT:
-        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r} (at most "
-                         f"{MAX_TIMEOUT}, a week)")
+    timeout = _checked_timeout(timeout)
     path = Path(path)
     notebook = read_notebook(path)
     running = [None, time.monotonic()]  # the cell running (its index) and since when
