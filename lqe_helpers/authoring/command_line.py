@@ -5,8 +5,8 @@
 warnings become one ``warning: ...`` line. Ctrl-C ends a tool with one line and status
 130, SIGTERM with one line and status 143 (it is raised where the tool is, as
 :class:`~lqe_helpers.authoring.errors.Terminated`, so a build in progress is undone and
-a kernel stopped), and so does Ctrl-C while a tool is still importing what it needs
-(:func:`interrupt_exits_quietly`). Standard library only.
+a kernel stopped), and so do Ctrl-C and SIGTERM while a tool is still importing what it
+needs (:func:`interrupt_exits_quietly`). Standard library only.
 """
 
 from __future__ import annotations
@@ -125,18 +125,23 @@ def sigterm_raises() -> Iterator[None]:
 
 @contextlib.contextmanager
 def interrupt_exits_quietly(module_name: str) -> Iterator[None]:
-    """Around a tool's imports: Ctrl-C then ends ``python -m <tool>`` with one line.
+    """Around a tool's imports: Ctrl-C or SIGTERM then ends ``python -m <tool>`` with one line.
 
     The heavy imports of a tool (nbconvert, nbclient) take a second or more; a Ctrl-C
-    then would print a traceback. For the module run as ``__main__`` this prints
-    ``error: interrupted while starting`` and exits with status 130 instead; for a
-    module imported by other code it does nothing.
+    then would print a traceback, and SIGTERM end it without a word. For the module run
+    as ``__main__`` this prints ``error: interrupted while starting`` (status 130) or
+    ``error: stopped by SIGTERM while starting`` (status 143) instead; for a module
+    imported by other code it does nothing.
     """
     if module_name != "__main__":
         yield
         return
     try:
-        yield
+        with sigterm_raises():
+            yield
     except KeyboardInterrupt:
         print("error: interrupted while starting; nothing was done", file=sys.stderr)
         raise SystemExit(INTERRUPTED_STATUS) from None
+    except Terminated:
+        print("error: stopped by SIGTERM while starting; nothing was done", file=sys.stderr)
+        raise SystemExit(TERMINATED_STATUS) from None

@@ -14,8 +14,9 @@ from collections.abc import Sequence
 
 # Terminal colour codes, as IPython puts them in tracebacks.
 _ANSI_COLOUR = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
-# Characters that would break a one-line message (newlines, tabs, other controls).
-_CONTROL = re.compile(r"[\x00-\x1f\x7f]")
+# Characters that would break a one-line message (newlines, tabs, other controls) or its
+# printing (the surrogates that stand for the bytes of a file name that is not UTF-8).
+_CONTROL = re.compile(r"[\x00-\x1f\x7f\ud800-\udfff]")
 #: How many places :func:`summarise` names before saying how many more there are.
 NAMED_PLACES = 3
 
@@ -57,7 +58,8 @@ def first_line(text: str) -> str:
 
 def shown(name: object) -> str:
     """``name`` as a message shows it: as it is, or quoted with escapes if it holds a
-    newline or another control character (so the message stays one line)."""
+    newline, another control character or a byte of a name that is not UTF-8 (so the
+    message stays one line, and printable)."""
     text = str(name)
     return repr(text) if _CONTROL.search(text) else text
 

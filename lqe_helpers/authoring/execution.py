@@ -1,15 +1,16 @@
 """Run one notebook top to bottom in a fresh kernel, within its time limit.
 
 :func:`execute_notebook` is what the notebook runner and the handouts build execute a
-notebook with. nbclient runs the kernel in a worker thread while the calling thread
-watches it, so that:
+notebook with: nbclient as it is, in a worker thread (its own event loop, run by
+:func:`asyncio.run`), while the calling thread waits, so that:
 
-- ``--timeout`` holds: nbclient stops a cell past its limit; should anything else hold
-  the run up (the kernel never starting, the client stuck on an output), the run is
-  stopped :data:`GRACE_SECONDS` later all the same;
+- ``--timeout`` is nbclient's time limit per cell; should anything else hold the run up
+  (the kernel never starting, the client stuck), it is stopped :data:`GRACE_SECONDS`
+  later all the same;
 - Ctrl-C and SIGTERM (:class:`~lqe_helpers.authoring.errors.Terminated`, once the tool's
-  command line turned SIGTERM into one) stop the kernel at once and end the run with one
-  line naming the notebook and the cell;
+  command line turned SIGTERM into one) reach the calling thread, which kills the kernel
+  and ends the run with one line naming the notebook and the cell (a second signal only
+  cuts the wait for nbclient to tidy up short);
 - pieces of one stream (stdout, stderr) are merged into one output per cell
   (:func:`merge_streams`) in time linear in their length. nbclient's own merging runs a
   regular expression whose time grows with the square of a line's length (100 k
@@ -20,6 +21,8 @@ watches it, so that:
 from __future__ import annotations
 
 import argparse
+import asyncio
+import contextlib
 import os
 import signal
 import tempfile
@@ -60,13 +63,18 @@ class NotebookRunError(ToolError, RuntimeError):
 def positive_seconds(text: str) -> float:
     """``--timeout``'s type: a number of seconds > 0 and at most :data:`MAX_TIMEOUT`."""
     try:
-        value = float(text)
+        return _checked_timeout(float(text))
     except ValueError:
-        value = float("nan")
-    if not 0 < value <= MAX_TIMEOUT:
         raise argparse.ArgumentTypeError(f"must be a number of seconds > 0, got {text!r} (at "
-                                         f"most {MAX_TIMEOUT}, a week)")
-    return value
+                                         f"most {MAX_TIMEOUT}, a week)") from None
+
+
+def _checked_timeout(timeout: object) -> float:
+    if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
+            or not 0 < timeout <= MAX_TIMEOUT:
+        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r} (at most "
+                         f"{MAX_TIMEOUT}, a week)")
+    return timeout
 
 
 def cell_label(notebook: nbformat.NotebookNode, index: int | None) -> str:
@@ -104,132 +112,51 @@ def merge_streams(outputs: list[Any]) -> list[Any]:
     output does not make two runs of the same notebook differ.
     """
     merged: list[Any] = []
-    pieces: dict[str, list[str]] = {}
-    first: dict[str, Any] = {}
+    streams: dict[str, tuple[Any, list[str]]] = {}  # name: its first output, its pieces
     for output in outputs:
-        if output.get("output_type") == "stream":
-            name = output["name"]
-            if name not in first:
-                first[name] = output
-                pieces[name] = []
-                merged.append(output)
-            pieces[name].append(output["text"])
-        else:
+        if output.get("output_type") != "stream":
             merged.append(output)
-    for name, output in first.items():
-        output["text"] = without_overwritten_text("".join(pieces[name]))
-    for index, output in enumerate(merged):  # as nbclient orders the two streams
-        if output["output_type"] == "stream" and output["name"] == "stderr" and (
-                len(merged) >= index + 2 and merged[index + 1]["output_type"] == "stream"
-                and merged[index + 1]["name"] == "stdout"):
-            merged.insert(index, merged.pop(index + 1))
+        elif output["name"] in streams:
+            streams[output["name"]][1].append(output["text"])
+        else:
+            streams[output["name"]] = (output, [output["text"]])
+            merged.append(output)
+    for output, pieces in streams.values():
+        output["text"] = without_overwritten_text("".join(pieces))
+    if {"stderr", "stdout"} <= streams.keys():  # stderr right before stdout: after it
+        place = next(i for i, output in enumerate(merged) if output is streams["stderr"][0])
+        if place + 1 < len(merged) and merged[place + 1] is streams["stdout"][0]:
+            merged[place:place + 2] = merged[place + 1], merged[place]
     return merged
 
 
-class _KernelRun:
-    """One notebook executed by nbclient in a worker thread, watched by the caller's."""
+def _kill_kernel(client: NotebookClient) -> None:
+    """Kill the kernel's process (its process group, if it has its own), if it started."""
+    provisioner = getattr(client.km, "provisioner", None)
+    pid, group = getattr(provisioner, "pid", None), getattr(provisioner, "pgid", None)
+    with contextlib.suppress(OSError):  # gone already
+        if group and group != os.getpgrp():
+            os.killpg(group, signal.SIGKILL)
+        elif pid:
+            os.kill(pid, signal.SIGKILL)
 
-    def __init__(self, notebook: nbformat.NotebookNode, path: Path, timeout: float,
-                 kernel_name: str, allow_errors: bool) -> None:
-        self.notebook, self.path, self.timeout = notebook, path, timeout
-        self.cell: int | None = None
-        self.since = time.monotonic()
-        self.stopping = False
-        self.error: BaseException | None = None
-        self.client = NotebookClient(
-            notebook, timeout=timeout, kernel_name=kernel_name,
-            resources={"metadata": {"path": str(path.parent.resolve())}},
-            store_widget_state=False, record_timing=False, allow_errors=allow_errors,
-            coalesce_streams=False,  # merged afterwards, in linear time (merge_streams)
-            on_cell_start=self._cell_started,
-        )
 
-    def _cell_started(self, cell: Any, cell_index: int) -> None:
-        if self.stopping:
-            raise RuntimeError("the run was stopped")
-        self.cell, self.since = cell_index, time.monotonic()
-
-    def _work(self, stderr: int) -> None:
-        try:
-            self.client.execute(stderr=stderr)
-        except BaseException as error:  # handed to the watching thread
-            self.error = error
-
-    def _deadline(self) -> float:
-        limit = self.timeout if self.cell is not None else max(self.timeout,
-                                                               self.client.startup_timeout)
-        return self.since + limit + GRACE_SECONDS
-
-    def _stop_kernel(self) -> None:
-        """Kill the kernel process (and its process group, if it has its own)."""
-        self.stopping = True
-        provisioner = getattr(self.client.km, "provisioner", None)
-        pid, group = getattr(provisioner, "pid", None), getattr(provisioner, "pgid", None)
-        try:
-            if group and hasattr(os, "killpg") and group != os.getpgrp():
-                os.killpg(group, signal.SIGKILL)
-            elif pid:
-                os.kill(pid, signal.SIGKILL)
-        except OSError:
-            pass  # gone already
-
-    def where(self) -> str:
-        return f"{shown(self.path)}: {cell_label(self.notebook, self.cell)}"
-
-    def execute(self) -> None:
-        """Run the notebook; raise :class:`NotebookRunError`, KeyboardInterrupt or
-        :class:`Terminated` (each naming the notebook and the cell) if it does not end."""
-        with tempfile.TemporaryFile() as kernel_stderr:
-            worker = threading.Thread(target=self._work, args=(kernel_stderr.fileno(),),
-                                      name=f"kernel for {self.path.name}", daemon=True)
-            worker.start()
-            try:
-                while worker.is_alive():
-                    worker.join(0.2)
-                    if worker.is_alive() and time.monotonic() > self._deadline():
-                        raise NotebookRunError(
-                            f"{self.where()} ran longer than the time limit of "
-                            f"{self.timeout:g} s per cell (--timeout); the kernel was stopped")
-            except BaseException as stop:
-                self._stop_kernel()
-                self._wait_for(worker)
-                if isinstance(stop, KeyboardInterrupt):
-                    raise KeyboardInterrupt(f"interrupted while running {self.where()}; the "
-                                            f"kernel was stopped") from None
-                if isinstance(stop, Terminated):
-                    raise Terminated(f"stopped by SIGTERM while running {self.where()}; the "
-                                     f"kernel was stopped") from None
-                raise
-            if isinstance(self.error, CellTimeoutError | DeadKernelError | CellExecutionError):
-                kernel_stderr.seek(0)
-                log = kernel_stderr.read().decode("utf-8", "replace").strip()
-                raise self._run_error(self.error, log) from self.error
-            if self.error is not None:
-                raise self.error
-
-    def _wait_for(self, worker: threading.Thread) -> None:
-        """Let nbclient notice the stopped kernel and tidy up (a while at most)."""
-        end = time.monotonic() + STOP_WAIT_SECONDS
-        while worker.is_alive() and time.monotonic() < end:
-            worker.join(0.2)
-            self._stop_kernel()  # in case it was still starting
-
-    def _run_error(self, error: Exception, kernel_log: str) -> NotebookRunError:
-        """The :class:`NotebookRunError` for a run stopped by ``error``: the notebook, the
-        cell and what happened; then the cell's traceback and the kernel's own output."""
-        if isinstance(error, CellTimeoutError):
-            first = (f"{self.where()} ran longer than the time limit of {self.timeout:g} s per "
-                     f"cell (--timeout)")
-        elif isinstance(error, DeadKernelError):
-            first = f"{shown(self.path)}: the kernel died while running " \
-                    f"{cell_label(self.notebook, self.cell)}"
-        else:
-            first = f"{self.where()} raised {error.ename}: {error.evalue}"
-        details = [strip_colour(error.traceback).strip()] \
-            if isinstance(error, CellExecutionError) else []
-        if kernel_log:
-            details.append(f"The kernel's own output:\n{kernel_log}")
-        return NotebookRunError("\n".join([first, *details]))
+def _run_error(error: BaseException, path: Path, cell: str, timeout: float,
+               log: str) -> NotebookRunError:
+    """The :class:`NotebookRunError` for nbclient's ``error`` in ``cell`` (its label): the
+    notebook, the cell and what happened; then the cell's traceback and the kernel's own
+    output, if any."""
+    if isinstance(error, DeadKernelError):
+        first = f"{shown(path)}: the kernel died while running {cell}"
+    elif isinstance(error, CellExecutionError):
+        first = f"{shown(path)}: {cell} raised {error.ename}: {error.evalue}"
+    else:
+        first = (f"{shown(path)}: {cell} ran longer than the time limit of {timeout:g} s per "
+                 f"cell (--timeout)")
+    details = [strip_colour(error.traceback).strip()] \
+        if isinstance(error, CellExecutionError) else []
+    return NotebookRunError("\n".join([first, *details, *(
+        [f"The kernel's own output:\n{log}"] if log else [])]))
 
 
 def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
@@ -267,13 +194,60 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
     ValueError
         If ``timeout`` is not a number of seconds > 0 and at most :data:`MAX_TIMEOUT`.
     """
-    if isinstance(timeout, bool) or not isinstance(timeout, int | float) \
-            or not 0 < timeout <= MAX_TIMEOUT:
-        raise ValueError(f"timeout must be a number of seconds > 0, got {timeout!r} (at most "
-                         f"{MAX_TIMEOUT}, a week)")
+    timeout = _checked_timeout(timeout)
     path = Path(path)
     notebook = read_notebook(path)
-    _KernelRun(notebook, path, timeout, kernel_name, allow_errors).execute()
+    running = [None, time.monotonic()]  # the cell running (its index) and since when
+
+    def cell_started(cell: Any, cell_index: int) -> None:
+        running[:] = [cell_index, time.monotonic()]
+
+    client = NotebookClient(
+        notebook, timeout=timeout, kernel_name=kernel_name, on_cell_start=cell_started,
+        resources={"metadata": {"path": str(path.parent.resolve())}},
+        store_widget_state=False, record_timing=False, allow_errors=allow_errors,
+        coalesce_streams=False)  # merged afterwards, in linear time (merge_streams)
+    # nbclient's exit hook would stop a kernel stopped here already, and print tracebacks.
+    client._cleanup_kernel = lambda: None
+    failed: list[BaseException] = []
+    with tempfile.TemporaryFile() as log:
+        def work() -> None:  # asyncio.run: no task of nbclient's is left pending
+            try:
+                asyncio.run(client.async_execute(stderr=log.fileno()))
+            except Exception as error:
+                failed.append(error)
+
+        worker = threading.Thread(target=work, name=f"kernel for {path.name}", daemon=True)
+        worker.start()
+        where = lambda: f"{shown(path)}: {cell_label(notebook, running[0])}"  # noqa: E731
+        try:
+            while worker.is_alive():
+                worker.join(0.2)
+                limit = timeout if running[0] is not None else max(timeout,
+                                                                   client.startup_timeout)
+                if worker.is_alive() and time.monotonic() > running[1] + limit + GRACE_SECONDS:
+                    raise NotebookRunError(f"{where()} ran longer than the time limit of "
+                                           f"{timeout:g} s per cell (--timeout); the kernel "
+                                           f"was stopped")
+        except BaseException as stop:
+            with contextlib.suppress(KeyboardInterrupt, Terminated):  # a second signal
+                end = time.monotonic() + STOP_WAIT_SECONDS
+                while worker.is_alive() and time.monotonic() < end:
+                    _kill_kernel(client)  # again, in case it was still starting
+                    worker.join(0.2)
+            if isinstance(stop, KeyboardInterrupt):
+                raise KeyboardInterrupt(f"interrupted while running {where()}; the kernel "
+                                        f"was stopped") from None
+            if isinstance(stop, Terminated):
+                raise Terminated(f"stopped by SIGTERM while running {where()}; the kernel "
+                                 f"was stopped") from None
+            raise
+        if failed:
+            if not isinstance(failed[0], CellTimeoutError | DeadKernelError | CellExecutionError):
+                raise failed[0]
+            log.seek(0)
+            raise _run_error(failed[0], path, cell_label(notebook, running[0]), timeout,
+                             log.read().decode("utf-8", "replace").strip()) from failed[0]
     for cell in notebook.cells:
         if cell.get("outputs"):
             cell.outputs = merge_streams(cell.outputs)

@@ -29,6 +29,9 @@ their own box.
 
 from __future__ import annotations
 
+import base64
+import binascii
+import io
 import re
 from collections.abc import Sequence
 from pathlib import Path
@@ -37,6 +40,7 @@ import nbformat
 from jinja2 import DictLoader
 from nbconvert.exporters import HTMLExporter
 from nbconvert.preprocessors import Preprocessor
+from PIL import Image, UnidentifiedImageError
 from traitlets import List, Unicode
 from traitlets.config import Config
 
@@ -328,6 +332,39 @@ def undescribed_figures(notebook: nbformat.NotebookNode) -> list[str]:
             if shown in FIGURE_MIMETYPES and figure_description(output) is None:
                 found.append(f"cell {index}")
     return found
+
+
+def png_fault(text: object) -> str | None:
+    """What is wrong with an ``image/png`` output's data (base64 text), or ``None``.
+
+    Not text, not base64, no bytes, not a PNG (Pillow reads and verifies it: its
+    signature and the checksum of every chunk), or a picture of zero width or height.
+    """
+    try:
+        data = base64.b64decode("".join(text.split()), validate=True)
+    except (AttributeError, binascii.Error, ValueError):
+        return "its data is not base64 text"
+    if not data:
+        return "it is empty (0 bytes)"
+    try:
+        with Image.open(io.BytesIO(data), formats=["PNG"]) as image:
+            size = image.size
+            image.verify()
+    except UnidentifiedImageError:
+        return f"its {len(data)} bytes are not a PNG"
+    except (OSError, SyntaxError, ValueError) as error:
+        return f"its {len(data)} bytes are not a valid PNG ({error})"
+    return None if min(size) > 0 else f"it is {size[0]}×{size[1]} pixels"
+
+
+def broken_pngs(notebook: nbformat.NotebookNode) -> list[str]:
+    """Where ``notebook`` shows an ``image/png`` output its page could not show:
+    ``"cell N: <what is wrong>"`` per output (:func:`png_fault`); ``N`` counts every
+    cell (markdown included) from 0."""
+    return [f"cell {index}: {fault}" for index, cell in enumerate(notebook.cells)
+            for output in cell.get("outputs", [])
+            if "image/png" in output.get("data", {})
+            and (fault := png_fault(output["data"]["image/png"])) is not None]
 
 
 class _PageResources(Preprocessor):

@@ -216,6 +216,11 @@ def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode
             f"{path} displays widget(s) with no static view, which a page could only show "
             f"as a placeholder (display an Explorer, or a figure): "
             f"{summarise(widgets, separator='; ')}")
+    broken = handout_pages.broken_pngs(notebook)
+    if broken:
+        raise HandoutBuildError(f"{path} shows image/png output(s) that are not a valid PNG, "
+                                f"which its page could not show: "
+                                f"{summarise(broken, separator='; ')}")
     undescribed = handout_pages.undescribed_figures(notebook)
     if undescribed:
         warnings.warn(f"{path} shows figure(s) with no description, which its page can "

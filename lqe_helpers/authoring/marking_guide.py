@@ -143,10 +143,15 @@ def question_and_marks(notebook: nbformat.NotebookNode, name: str) -> tuple[str,
     Raises
     ------
     ValueError
-        If the notebook's ``lqe`` metadata gives marks other than the tutorial's for
-        its question, or neither the metadata nor the file name says which question.
+        If the notebook's ``lqe`` metadata is not a mapping or gives marks other than
+        the tutorial's for its question, or neither the metadata nor the file name
+        says which question.
     """
     meta = notebook.metadata.get("lqe", {})
+    if not isinstance(meta, dict):
+        raise ValueError(f"{name}: its metadata 'lqe' must be a mapping, such as "
+                         f'{{"question": "a", "marks": 15, "core_minutes": 45}}, got '
+                         f"{type(meta).__name__} {shown(repr(meta)[:60])}")
     question = meta.get("question", NOTEBOOK_QUESTIONS.get(name[:2]))
     if question is None:
         raise ValueError(f"{name}: no question in its metadata 'lqe' and none known for its "

@@ -24,7 +24,7 @@ whole pack):
 
 These four are the only tags a source notebook may carry (:data:`ALLOWED_TAGS`). An
 unknown or misspelt tag (``Solution``, ``answers``), an explorer without
-``nbval-ignore-output``, or a code cell that starts like a task (``# Task:``) but is not
+``nbval-ignore-output``, or a code cell with a ``# Task:`` comment on any line but not
 tagged ``solution`` stops the build with the notebook and the cell named: a silent pass
 would hand out a worked answer.
 

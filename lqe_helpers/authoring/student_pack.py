@@ -215,8 +215,8 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     ValueError
         If a needed file is missing, a notebook breaks the tag convention or has no
         solution cell, the Makefile lacks a rule the pack keeps, a file to copy is a
-        symbolic link or not a regular file, or a text file is not UTF-8 (the message
-        names the file).
+        symbolic link or not a regular file, or a text file or a file's name is not
+        UTF-8 (the message names the file).
     """
     root = Path(root)
     for needed in ("Makefile", *TOP_FILES, "lqe_helpers/__init__.py", "tests",
@@ -256,6 +256,10 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     for name in TOP_FILES:
         files[name] = _read_bytes(root / name)
     files[MARKER_NAME] = marker_text().encode()
+    for name in files:  # a zip names its files in UTF-8
+        if name.encode("utf-8", "replace").decode("utf-8") != name:
+            raise ValueError(f"{shown(root / name)}: its name is not UTF-8; the student pack "
+                             f"(a zip) names its files in UTF-8: rename it")
     return dict(sorted(files.items()))
 
 

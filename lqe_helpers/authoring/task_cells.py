@@ -217,8 +217,8 @@ def check_cell_tags(cell: nbformat.NotebookNode, where: str) -> None:
         If the cell carries a tag outside :data:`ALLOWED_TAGS` (the message suggests
         the nearest allowed one), a tag on the wrong kind of cell, ``solution`` and
         ``answer`` together, an explorer also marked as a solution or an answer or
-        without ``nbval-ignore-output``, or if it is a code cell whose leading comments
-        hold a task instruction (:func:`looks_like_a_task`) without the ``solution`` tag.
+        without ``nbval-ignore-output``, or if it is a code cell with a task instruction
+        on any line (:func:`task_line`) without the ``solution`` tag.
     """
     tags = cell_tags(cell)
     for tag in tags:
@@ -247,24 +247,17 @@ def check_cell_tags(cell: nbformat.NotebookNode, where: str) -> None:
     if is_answer and cell.cell_type != "markdown":
         raise ValueError(f"{where}: tag {ANSWER_TAG!r} is for markdown cells, got a "
                          f"{cell.cell_type} cell")
-    if cell.cell_type == "code" and not is_solution and looks_like_a_task(cell.source):
-        raise ValueError(f"{where}: starts like a task but is not tagged {SOLUTION_TAG!r} (a "
-                         f"'# Task:' comment at its top), so its worked code would be handed "
-                         f"out; tag it {SOLUTION_TAG!r}")
+    line = task_line(cell.source) if cell.cell_type == "code" and not is_solution else None
+    if line is not None:
+        raise ValueError(f"{where}: holds a task instruction ('# Task:' comment, line {line}) "
+                         f"but is not tagged {SOLUTION_TAG!r}, so its worked code would be "
+                         f"handed out; tag it {SOLUTION_TAG!r} and put the '# Task:' comment "
+                         f"at its top")
 
 
-def looks_like_a_task(source: str) -> bool:
-    """Whether a code cell's leading block holds a task instruction.
-
-    The leading block is every line before the first line of code: blank lines,
-    comments and IPython magics (``%%time``, ``!pip ...``). A comment there that reads
-    like ``# Task:`` (:data:`TASK_LIKE`: any case, spacing or number of ``#``) makes the
-    cell a task, wherever it is in the block.
-    """
-    for line in source.splitlines():
-        stripped = line.strip()
-        if stripped and not stripped.startswith(("#", "%", "!")):
-            return False
-        if TASK_LIKE.match(stripped):
-            return True
-    return False
+def task_line(source: str) -> int | None:
+    """The number (from 1) of a code cell's first comment line that reads like a task
+    instruction (:data:`TASK_LIKE`: ``# Task:`` in any case, spacing or number of
+    ``#``), wherever it is in the cell (after an import line, say); ``None`` if none."""
+    return next((number for number, line in enumerate(source.splitlines(), 1)
+                 if TASK_LIKE.match(line.strip())), None)

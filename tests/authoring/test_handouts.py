@@ -26,6 +26,7 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_outp
 from lqe_helpers.authoring import files, handout_pages, handouts
 from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError
 from lqe_helpers.authoring.manifest import MANIFEST_NAME
+from lqe_helpers.authoring.notebook_io import read_notebook
 from lqe_helpers.authoring.student_edition import EXPLORER_TAG
 
 NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
@@ -408,6 +409,31 @@ def test_stderr_is_reported(tmp_path):
     write_fixture(tmp_path / "src", "06_warns", cells)
     with pytest.warns(handouts.HandoutWarning, match=r"06_warns\.ipynb.*cell 0: careful"):
         handouts.build_handouts(tmp_path / "src", tmp_path / "out")
+
+
+@pytest.mark.parametrize(("data", "fault"), [
+    ("not base64 at all!", "its data is not base64 text"),
+    ("", "it is empty (0 bytes)"),
+    (base64.b64encode(b"GIF89a" + bytes(30)).decode(), "its 36 bytes are not a PNG"),
+    (base64.b64encode(PIXEL[:-12]).decode(), "its 58 bytes are not a valid PNG (truncated"),
+    (base64.b64encode(PIXEL[:-8] + b"\0\0\0\0" + PIXEL[-4:]).decode(),
+     "its 70 bytes are not a valid PNG (broken PNG file"),
+])
+def test_a_broken_png_output_stops_the_build_naming_notebook_and_cell(tmp_path, monkeypatch,
+                                                                      capsys, data, fault):
+    """Issue 27: an image/png output that is no PNG passed the build (a broken picture)."""
+    broken = new_output("display_data", data={"image/png": data, "text/plain": "<Figure>"},
+                        metadata={"image/png": {"alt": "A figure."}})
+    cells = [new_markdown_cell("# Broken"), new_code_cell("show()", outputs=[broken])]
+    path = write_fixture(tmp_path / "src", "01_broken", cells)
+    monkeypatch.setattr(handouts, "execute_notebook",
+                        lambda path, timeout=None, allow_errors=False: read_notebook(path))
+    assert handouts.main(["--source", str(tmp_path / "src"), "--out", str(tmp_path / "out"),
+                          "--mathjax-url", ""]) == 1
+    [line] = capsys.readouterr().err.splitlines()
+    assert line.startswith(f"error: {path} shows image/png output(s) that are not a valid "
+                           f"PNG, which its page could not show: cell 1: {fault}"), line
+    assert not (tmp_path / "out").exists()
 
 
 def test_bad_folders_are_refused_before_any_notebook_runs(tmp_path, monkeypatch):

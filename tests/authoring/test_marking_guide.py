@@ -153,6 +153,9 @@ def test_guide_is_the_same_every_time_and_the_command_line(tmp_path, capsys):
     (lambda nb: nb.cells[4].update(source="checks.check_everything(mse)"),
      "does not define"),
     (lambda nb: nb.metadata["lqe"].update(marks=30), "the tutorial gives it 25"),
+    (lambda nb: nb.metadata.update(lqe=["c", 25]),  # issue 27: it said only AttributeError
+     r"^03_fixture\.ipynb: its metadata 'lqe' must be a mapping, such as \{\"question\": "
+     r"\"a\", \"marks\": 15, \"core_minutes\": 45\}, got list \['c', 25\]$"),
 ])
 def test_a_notebook_that_cannot_give_a_guide_is_refused(tmp_path, change, message):
     notebook = guide_fixture()

@@ -255,8 +255,13 @@ def test_allowed_tags_are_defined_once():
         (5, new_markdown_cell(ANSWER, metadata={"tags": ["answer", "remove-me"]}),
          "unknown tag 'remove-me'; the allowed tags are answer, explorer, "
          "nbval-ignore-output, solution"),
-        (3, new_code_cell(SOLUTION), "starts like a task but is not tagged 'solution'"),
-        (3, new_code_cell("  #task : lower case and spaced\nx = 1"), "starts like a task"),
+        (3, new_code_cell(SOLUTION), "holds a task instruction ('# Task:' comment, line 1) "
+         "but is not tagged 'solution'"),
+        (3, new_code_cell("  #task : lower case and spaced\nx = 1"), "line 1) but is not tagged"),
+        # Issue 27: a '# Task:' after an import line (or any code) shipped its worked code.
+        (3, new_code_cell("import numpy as np\n" + SOLUTION), "('# Task:' comment, line 2) but "
+         "is not tagged 'solution'"),
+        (3, new_code_cell("x = 1\n\n## task: after code\ny = x"), "line 3) but is not tagged"),
         (6, new_code_cell(EXPLORER, metadata={"tags": ["explorer"]}),
          "must also be tagged 'nbval-ignore-output'"),
         (2, new_markdown_cell("text", metadata={"tags": ["explorer", "nbval-ignore-output"]}),

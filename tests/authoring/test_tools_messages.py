@@ -1,14 +1,17 @@
 """One line, naming the thing: the tools' messages under attack.
 
-Issue 19: Ctrl-C while a tool was still importing printed a traceback; a non-UTF-8 file
-in the student pack, a deeply nested notebook and ``File too large`` (``ulimit -f``)
-named no file; one error line repeated the same sentence 171 times (the handouts build,
-when its folder holds a MathJax copy it did not write: one sentence per MathJax file).
+Issue 19: Ctrl-C while a tool was still importing printed a traceback (issue 27: SIGTERM
+then printed nothing); a non-UTF-8 file in the student pack, a deeply nested notebook and
+``File too large`` (``ulimit -f``) named no file; one error line repeated the same
+sentence 171 times (the handouts build, when its folder holds a MathJax copy it did not
+write: one sentence per MathJax file).
 """
 
 from __future__ import annotations
 
+import os
 import resource
+import shutil
 import signal
 import subprocess
 import textwrap
@@ -49,8 +52,10 @@ SLOW_IMPORT = textwrap.dedent("""
 """)
 
 
+@pytest.mark.parametrize(("how", "status", "said"), [
+    (signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 143, "stopped by SIGTERM")])
 @pytest.mark.parametrize("tool", TOOLS)
-def test_ctrl_c_while_a_tool_is_importing_is_one_line(tmp_path, tool):
+def test_a_signal_while_a_tool_is_importing_is_one_line(tmp_path, tool, how, status, said):
     hooks = tmp_path / "hooks"
     hooks.mkdir()
     (hooks / "sitecustomize.py").write_text(SLOW_IMPORT)
@@ -65,10 +70,10 @@ def test_ctrl_c_while_a_tool_is_importing_is_one_line(tmp_path, tool):
     while not importing.exists():
         assert time.monotonic() < end and process.poll() is None, process.communicate()
         time.sleep(0.05)
-    process.send_signal(signal.SIGINT)
+    process.send_signal(how)
     out, err = process.communicate(timeout=60)
-    assert err == "error: interrupted while starting; nothing was done\n", err
-    assert process.returncode == 130
+    assert err == f"error: {said} while starting; nothing was done\n", err
+    assert process.returncode == status
     assert out == ""
 
 
@@ -83,6 +88,23 @@ def test_a_non_utf8_file_in_the_pack_is_named(tmp_path, where):
     with pytest.raises(ValueError) as raised:
         student_pack.build_student_pack(course, tmp_path / "out")
     assert error_line(raised.value).startswith(f"{path} is not UTF-8 text (invalid")
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("folder", ["lqe_helpers", "notebooks"])
+def test_a_file_name_that_is_not_utf8_is_named_escaped(tmp_path, capsys, folder):
+    """Issue 27: the pack said only "'utf-8' codec can't encode character '\\udce9'"."""
+    course = make_course(tmp_path / "course")
+    name = os.fsdecode(b"caf\xe9.py" if folder == "lqe_helpers" else b"02_caf\xe9.ipynb")
+    shutil.copy(course / "notebooks" / "01_first.ipynb", course / folder / name)
+    assert student_pack.main(["--root", str(course), "--out", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err
+    assert err == (f"error: '{course / folder}/caf\\udce9.py': its name is not UTF-8; the "
+                   f"student pack (a zip) names its files in UTF-8: rename it\n"
+                   if folder == "lqe_helpers" else
+                   f"error: '{course / folder}/02_caf\\udce9.ipynb': its name is not UTF-8; "
+                   f"the student pack (a zip) names its files in UTF-8: rename it\n"), err
+    assert err.isascii()
     assert not (tmp_path / "out").exists()
 
 

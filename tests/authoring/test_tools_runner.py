@@ -8,6 +8,7 @@ signals are involved.
 
 from __future__ import annotations
 
+import asyncio
 import json
 import os
 import random
@@ -200,6 +201,17 @@ def test_the_merge_of_one_long_line_takes_linear_time():
     assert time.perf_counter() - begin < 1.0  # nbclient's regex: hours
 
 
+def test_the_merge_of_100k_pieces_takes_linear_time():
+    """A cell printing 100 k short lines, flushed one by one: nbclient's merge (one string
+    grown piece by piece) takes about 16 s here; ours a fraction of a second."""
+    pieces = [{"output_type": "stream", "name": "stdout", "text": f"line {i}\r{i}\n"}
+              for i in range(100_000)]
+    begin = time.perf_counter()
+    [merged] = merge_streams(pieces)
+    assert time.perf_counter() - begin < 2.0
+    assert merged["text"] == "".join(f"{i}\n" for i in range(100_000))
+
+
 @pytest.mark.slow
 @pytest.mark.kernel
 def test_a_one_megabyte_line_is_saved_in_seconds(tmp_path):
@@ -264,17 +276,59 @@ def test_a_signal_stops_the_kernel_and_ends_the_run_with_one_line(tmp_path, how,
 
 
 @pytest.mark.slow
+@pytest.mark.kernel
+@pytest.mark.parametrize(("tool", "how", "said"), [
+    ("notebook_runner", signal.SIGINT, "interrupted while running"),
+    ("handouts", signal.SIGINT, "interrupted while running"),
+])
+def test_a_signal_sent_twice_is_still_one_line(tmp_path, tool, how, said):
+    """Issue 27: Ctrl-C twice added 17–33 lines of nbclient's exit tracebacks; SIGTERM
+    twice named no notebook or cell. The second signal comes while the kernel is stopped."""
+    source = tmp_path / "notebooks"
+    path = code_notebook(source / "01_endless.ipynb", ENDLESS)
+    arguments = ([str(path)] if tool == "notebook_runner" else
+                 ["--source", str(source), "--out", str(tmp_path / "out"), "--mathjax-url", ""])
+    process = started(tool, arguments, tmp_path)
+    wait_for(source / "kernel.pid")
+    kernel = int((source / "kernel.pid").read_text())
+    process.send_signal(how)
+    time.sleep(0.05)
+    process.send_signal(how)
+    _, err = process.communicate(timeout=60)
+    assert err.splitlines() == [f"error: {said} {path}: cell 0 (import os, time); the kernel "
+                                f"was stopped"], err
+    # Killed by the second signal once its work was done, or exited: a shell says 128 + it.
+    assert process.returncode in (128 + how, -how)
+    assert gone(kernel), "the kernel is still running"
+
+
+@pytest.mark.slow
+@pytest.mark.kernel
+def test_the_time_limit_on_a_kernel_that_ignores_ctrl_c_is_one_line(tmp_path):
+    """Issue 27: nbclient left a task pending, and asyncio printed 'Task was destroyed'."""
+    path = code_notebook(tmp_path / "01_deaf.ipynb", "import signal, time\n"
+                         "signal.signal(signal.SIGINT, signal.SIG_IGN)\nwhile True:\n"
+                         "    time.sleep(0.1)")
+    result = run_tool("notebook_runner", str(path), "--timeout", "2")
+    assert result.returncode == 1
+    assert result.stderr.splitlines() == [
+        f"error: {path}: cell 0 (import signal, time) ran longer than the time limit of 2 s "
+        f"per cell (--timeout) (--verbose shows the rest)"], result.stderr
+
+
+@pytest.mark.slow
 def test_the_time_limit_holds_even_if_the_client_hangs(tmp_path, monkeypatch):
     """nbclient stuck in a cell (here: it never returns from it, whatever its own time
     limit says): the run stops a grace period past the limit all the same."""
     path = code_notebook(tmp_path / "01.ipynb", "1 + 1")
     release = threading.Event()
 
-    def stuck(self, **kwargs):
+    async def stuck(self, **kwargs):
         self.on_cell_start(cell=self.nb.cells[0], cell_index=0)
-        release.wait(60)
+        while not release.is_set():
+            await asyncio.sleep(0.05)
 
-    monkeypatch.setattr(execution.NotebookClient, "execute", stuck)
+    monkeypatch.setattr(execution.NotebookClient, "async_execute", stuck)
     monkeypatch.setattr(execution, "GRACE_SECONDS", 0.5)
     monkeypatch.setattr(execution, "STOP_WAIT_SECONDS", 0.5)
     begin = time.monotonic()

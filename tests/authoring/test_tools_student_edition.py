@@ -1,7 +1,8 @@
 """The student edition never ships a worked answer because of how a cell is written.
 
 Issue 19: an untagged code cell whose ``# Task:`` line was its second line shipped its
-worked code; a misspelt tag on a notebook's only solution cell was reported as "no cell
+worked code (issue 27: so did one whose ``# Task:`` line followed an import line); a
+misspelt tag on a notebook's only solution cell was reported as "no cell
 is tagged 'solution'" instead of naming the typo.
 """
 
@@ -24,6 +25,9 @@ WORKED = "estimate = truth + 0.5  # the worked answer"
     f"## Task: add half a centimetre\n{WORKED}",
     f"%%time\n# Task: add half a centimetre\n{WORKED}",
     f"# TASK :  add half a centimetre\n{WORKED}",
+    # Issue 27: a '# Task:' comment after code (an import line, say) shipped the code too.
+    f"import numpy as np\n# Task: add half a centimetre.\n{WORKED}",
+    f"{WORKED}\n# Task: add half a centimetre (written below its code)",
 ])
 def test_an_untagged_cell_whose_comment_block_holds_a_task_stops_the_build(tmp_path, source):
     extra = [new_code_cell(source)]
@@ -39,7 +43,6 @@ def test_an_untagged_cell_whose_comment_block_holds_a_task_stops_the_build(tmp_p
 
 @pytest.mark.parametrize("source", [
     f"# Setup: nothing to do here.\n{WORKED}",
-    f"{WORKED}\n# Task: a comment after code is not an instruction",
     f"print('# Task: in a string')\n{WORKED}",
 ])
 def test_other_cells_still_pass(tmp_path, source):
