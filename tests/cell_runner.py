@@ -3,7 +3,8 @@
 The task-cell record (:mod:`lqe_helpers.student_code.task_runs`) listens to IPython's
 ``pre_run_cell`` and ``post_run_cell`` events. :class:`CellRunner` fires them around each
 cell it runs (as IPython does), without a kernel, so the tests of what a check judges
-(``tests/checks/test_own_work.py``, ``tests/checks/test_loopholes.py``) stay fast. Not a test module.
+(``tests/checks/test_own_work.py``, ``tests/checks/test_loopholes.py``) stay fast. Not a
+test module.
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ so a re-run with unchanged code gives a byte-identical file.
 
 Every notebook is read and checked first, then every one is executed, and only when
 all have run to the end are they saved, all together and atomically
-(:func:`~lqe_helpers.authoring.swap.atomic_write_many`: staged beside them, then
+(:func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`: staged beside them, then
 swapped in with renames; if one move fails the others are undone; if the process is killed
 while moving them, the next run finishes the move first). So a failure anywhere (a bad
 file, a cell that raises, a cell past its time limit, a kernel that dies, a full disk,
@@ -36,12 +36,12 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         positive_seconds,
     )
     from lqe_helpers.authoring.files import FileState, file_state, refuse_symlink
+    from lqe_helpers.authoring.folder_lock import FolderLock, atomic_write_many
     from lqe_helpers.authoring.notebook_io import (
         notebook_bytes,
         parse_notebook,
         read_notebook_bytes,
     )
-    from lqe_helpers.authoring.swap import FolderLock, atomic_write_many
 
 __all__ = ["CELL_TIMEOUT", "TOOL_NAME", "WIDGET_VIEW_MIMETYPE", "NotebookRunError",
            "execute_notebook", "fail", "main", "positive_seconds", "run_notebooks"]
@@ -84,7 +84,7 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
     The notebooks' folders are held for the whole run (a second runner on them stops at
     once; a save killed part-way before is finished first). Every path is checked, then
     every notebook executed; only if all run to the end are they saved, together and
-    atomically (:func:`~lqe_helpers.authoring.swap.atomic_write_many`). A notebook
+    atomically (:func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`). A notebook
     whose file would not change is not rewritten. A notebook whose file changed while
     the run went on (size, time or content: an edit saved from JupyterLab) is kept as it
     is on disk: nothing is written for it.

@@ -28,6 +28,7 @@ from pathlib import Path, PurePosixPath
 
 from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError, shown, summarise
 from lqe_helpers.authoring.files import as_bytes, file_sha256, sha256
+from lqe_helpers.authoring.folder_lock import FolderLock
 from lqe_helpers.authoring.manifest import (
     MANIFEST_NAME,
     Manifest,
@@ -35,7 +36,7 @@ from lqe_helpers.authoring.manifest import (
     name_problem,
     read_manifest,
 )
-from lqe_helpers.authoring.swap import FolderLock, swap_in
+from lqe_helpers.authoring.swap import swap_in
 
 
 def _ancestors(path: Path) -> list[Path]:

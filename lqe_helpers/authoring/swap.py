@@ -1,6 +1,6 @@
 """Swap a finished build into a folder with renames; one tool at a time; survive a kill.
 
-A swap (:func:`swap_in`, :func:`atomic_write_many`) in a folder:
+A swap (:func:`swap_in`, :func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`) in a folder:
 
 1. writes every new file into a temporary folder beside them, ``.lqe-build-<16 hex>/``
    (``new/<name>``, linked into place later, so it proves which files the swap placed),
@@ -13,7 +13,7 @@ A swap (:func:`swap_in`, :func:`atomic_write_many`) in a folder:
 4. removes the temporary folder, then the journal.
 
 A failure the process sees is undone at once (the journal says ``undo`` first). After
-a kill, the next tool to take the folder (:class:`FolderLock`) finishes the swap, or
+a kill, the next tool to take the folder (``folder_lock.FolderLock``) finishes the swap, or
 the undo, from the journal (:func:`recover`) and says which in one line
 (:class:`RecoveryWarning`). Nothing in a journal is trusted: a name must be a plain
 path inside the folder, a file replaced or deleted must be listed with that content
@@ -31,21 +31,14 @@ import secrets
 import shutil
 import signal
 import threading
-import warnings
 from collections.abc import Iterator, Mapping
 from dataclasses import asdict, dataclass, field
 from pathlib import Path, PurePosixPath
 
-try:
-    from filelock import lock_descriptor
-except ImportError:  # make clean with a broken .venv runs on the system's Python
-    lock_descriptor = None
 from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError, error_line, shown
 from lqe_helpers.authoring.errors import summarise as _summarise
 from lqe_helpers.authoring.files import (
     FileState,
-    as_bytes,
-    check_target,
     file_sha256,
     file_state,
     mode_for,
@@ -343,72 +336,6 @@ def _cannot_finish(folder: Path, journal: Journal, what: str, missing: list[str]
             f"longer as the manifest lists them are kept and named by the next build")
 
 
-class FolderLock:
-    """Hold ``folder`` for this process while a tool writes it (a context manager).
-
-    A :func:`filelock.lock_descriptor` lock on the folder itself (released by the system
-    even when the process is killed): another process stops at once with
-    :class:`OutputFolderError`; this process may take it again (nested). The first
-    time, a swap killed there is finished or undone (:func:`recover`), said as a
-    :class:`RecoveryWarning`.
-    """
-
-    _held: dict[tuple[int, int], int] = {}  # noqa: RUF012 (one registry for the process)
-
-    def __init__(self, folder: Path | str) -> None:
-        self.folder = Path(folder)
-        self._fd: int | None = None
-        self._key = (0, 0)
-
-    def __enter__(self) -> FolderLock:
-        fd = os.open(self.folder, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
-        status = os.fstat(fd)
-        self._key = (status.st_dev, status.st_ino)
-        if self._key in self._held:
-            os.close(fd)
-            self._held[self._key] += 1
-            return self
-        try:
-            locked = _lock(fd)
-        except OSError:
-            locked = True  # a file system without locks: go on unlocked
-        if not locked:
-            os.close(fd)
-            raise OutputFolderError(
-                f"another course tool is writing {shown(self.folder)} right now; wait until "
-                f"it ends, then run this again (nothing was changed)")
-        self._fd, self._held[self._key] = fd, 1
-        try:
-            note = recover(self.folder)
-        except BaseException:
-            self.__exit__()
-            raise
-        if note:
-            warnings.warn(note, RecoveryWarning, stacklevel=2)
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._held[self._key] -= 1
-        if self._held[self._key] == 0:
-            del self._held[self._key]
-            if self._fd is not None:
-                os.close(self._fd)  # releases the lock
-                self._fd = None
-
-
-def _lock(fd: int) -> bool:
-    """Lock the open folder ``fd`` (``filelock``'s flock); ``False`` if another holds it."""
-    if lock_descriptor is not None:
-        return lock_descriptor(fd, blocking=False)
-    import fcntl
-
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        return False
-    return True
-
-
 def _stage(folder: Path, tool: str, writes: Mapping[str, bytes],
            swaps: list[tuple[Path, Journal]]) -> Journal:
     """Step 1: a stamped temporary folder in ``folder`` holding every new file (its journal
@@ -463,10 +390,10 @@ def swap_in(folder: Path, writes: Mapping[str, bytes], deletes: Mapping[str, str
     OutputFolderError
         If a file changed since the caller looked (everything is then undone).
     """
-    _swap({folder: (writes, deletes, expected, {})}, tool, shown(folder), strict=True)
+    swap_folders({folder: (writes, deletes, expected, {})}, tool, shown(folder), strict=True)
 
 
-def _swap(plans: Mapping[Path, tuple[Mapping[str, bytes], Mapping[str, str],
+def swap_folders(plans: Mapping[Path, tuple[Mapping[str, bytes], Mapping[str, str],
                                      Mapping[str, str | None], Mapping[str, FileState]]],
           tool: str, where: str, *, strict: bool) -> set[tuple[Path, str]]:
     """Swap each folder's (writes, deletes, expected SHA-256s, expected states); every
@@ -509,40 +436,3 @@ def signals_deferred() -> Iterator[None]:
             signal.signal(number, handler if handler is not None else signal.SIG_DFL)
         if received:
             signal.raise_signal(received[0])
-
-
-def atomic_write_many(files: Mapping[Path | str, bytes | str], *,
-                      expected: Mapping[Path, FileState | None] | None = None,
-                      tool: str = "atomic_write_many") -> list[Path]:
-    """Replace (or create) several files, all or none; return the files written.
-
-    Grouped by folder: each folder is held (:class:`FolderLock`) and swapped; every new
-    content is staged in every folder before the first rename. A target that is not
-    its ``expected`` :class:`FileState` right before its rename (an author's edit) is
-    kept as it is and left out of the result. Within a folder a kill leaves wholly old
-    or wholly new after the next run; across folders one may be new and another old.
-
-    Raises
-    ------
-    FileSafetyError
-        If a target is a symbolic link or a folder (before anything is written).
-    OSError
-        If writing fails (every target is then as it was).
-    """
-    targets = {Path(path): as_bytes(data) for path, data in files.items()}
-    for path in targets:
-        check_target(path)
-    real = {path: Path(os.path.realpath(path.parent)) for path in targets}
-    groups: dict[Path, dict[str, bytes]] = {}
-    for path, data in targets.items():
-        groups.setdefault(real[path], {})[path.name] = data
-    states: dict[Path, dict[str, FileState]] = {}
-    for path, state in (expected or {}).items():
-        if state is not None:
-            states.setdefault(real[path], {})[path.name] = state
-    with contextlib.ExitStack() as held:
-        for folder in sorted(groups):
-            held.enter_context(FolderLock(folder))
-        kept = _swap({folder: (writes, {}, {}, states.get(folder, {}))
-                      for folder, writes in groups.items()}, tool, "those folders", strict=False)
-    return [path for path in targets if (real[path], path.name) not in kept]

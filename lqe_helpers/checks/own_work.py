@@ -34,26 +34,35 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..scenario import Scenario
 from ..student_code import task_runs
 from .machinery import FUNCTION_RTOL, CheckFailed, close
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
+#: The scenario's data a task may read (``DEFAULT.truth``, ``DEFAULT.unit_noise(...)``,
+#: ``DEFAULT.dt``, ...): the getters of :class:`~lqe_helpers.scenario.Scenario`'s properties
+#: and its noise draws. Reading the task's inputs computes none of its answer.
+SCENARIO_DATA: tuple[Callable, ...] = (
+    *(member.fget for member in vars(Scenario).values() if isinstance(member, property)),
+    Scenario.unit_noise)
+
 #: Per function task (by the function the student writes): the pack functions its text lets
-#: the student use inside it. Empty for every task today: each asks for the equation written
-#: with NumPy.
+#: the student use inside it. Empty for the tasks that get every input as an argument: each
+#: asks for the equation written with NumPy.
 FUNCTION_TASKS: dict[str, tuple[Callable, ...]] = {
     "my_transition_matrix": (),   # 00 Task 1
     "predict_covariance": (),     # 00 Task 2 (and Going further's covariance step)
     "my_filter": (),              # 01 Task 1
-    "vision_trial": (),           # 01 Task 2: calls the student's own (loaded) my_filter
+    "vision_trial": SCENARIO_DATA,  # 01 Task 2: the trial's data, then the student's my_filter
     "my_smoother": (),            # 01 Going further
     "compensate": (),             # 05 Task 1
 }
 
 #: The pack's filter engine: eq. (5) and everything built on it (a name ending in "." is
 #: a whole module).
-FILTER_ENGINE = ("lqe_helpers.filter.", "lqe_helpers.steady_state.", "lqe_helpers.lowpass.",
+FILTER_ENGINE = ("lqe_helpers.filter.", "lqe_helpers._engine.", "lqe_helpers.steady_state.",
+                 "lqe_helpers.lowpass.", "lqe_helpers.fixed_gain.",
                  "lqe_helpers.bias_model.tracking.")
 
 #: The pack's delay compensation, eq. (7), and its delayed runs.

@@ -100,11 +100,6 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
         raise errors[min(errors)]
     _explain_wrong_rows(name, models[wrong[0]], answers[wrong[0]], correct[wrong[0]])
 
-#: The pack's filter of eq. (5), which a student's function must not run: its public
-#: entry, and the core every run of the pack goes through (``experiments.track`` too).
-_PACKS_FILTER = (kalman_filter, _engine.filter_run)
-
-
 def _explain_wrong_rows(name: str, m: FilterCase, answer: np.ndarray,
                         right: np.ndarray) -> None:
     """CheckFailed for a filter whose numbers differ in no typical way."""

@@ -19,7 +19,7 @@ import pytest
 from nbformat.v4 import new_code_cell, new_notebook
 from tools_helpers import snapshot
 
-from lqe_helpers.authoring import command_line, files, manifest, notebook_io, swap
+from lqe_helpers.authoring import command_line, files, folder_lock, manifest, notebook_io
 from lqe_helpers.authoring.errors import (
     FileSafetyError,
     NotebookFileError,
@@ -92,7 +92,7 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
     # A full disk while the second is being written: nothing replaced yet.
     monkeypatch.setattr(files, "_write_fd", full_disk_after(3))
     with pytest.raises(OSError):
-        swap.atomic_write_many({first: "good after", second: "other after"})
+        folder_lock.atomic_write_many({first: "good after", second: "other after"})
     assert snapshot(tmp_path) == before
     monkeypatch.undo()
 
@@ -106,11 +106,11 @@ def test_atomic_write_many_is_all_or_nothing(tmp_path, monkeypatch):
 
     monkeypatch.setattr(os, "link", link)
     with pytest.raises(OSError):
-        swap.atomic_write_many({first: "good after", second: "other after"})
+        folder_lock.atomic_write_many({first: "good after", second: "other after"})
     monkeypatch.undo()
     assert snapshot(tmp_path) == before
 
-    assert swap.atomic_write_many({first: "good after",
+    assert folder_lock.atomic_write_many({first: "good after",
                                           second: b"other after"}) == [first, second]
     assert (first.read_text(), second.read_text()) == ("good after", "other after")
     assert sorted(os.listdir(tmp_path)) == ["good.ipynb", "other.ipynb"]

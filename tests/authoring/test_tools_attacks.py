@@ -28,8 +28,9 @@ from tools_helpers import (
 )
 
 from lqe_helpers.authoring.errors import OutputFolderError
+from lqe_helpers.authoring.folder_lock import FolderLock
 from lqe_helpers.authoring.output_folder import write_output_folder
-from lqe_helpers.authoring.swap import JOURNAL_NAME, FolderLock, RecoveryWarning
+from lqe_helpers.authoring.swap import JOURNAL_NAME, RecoveryWarning
 
 
 def journal(staging: str, writes: list | None = None, deletes: list | None = None, *,

@@ -33,7 +33,8 @@ from tools_helpers import (
     write_notebook,
 )
 
-from lqe_helpers.authoring.swap import FolderLock, RecoveryWarning
+from lqe_helpers.authoring.folder_lock import FolderLock
+from lqe_helpers.authoring.swap import RecoveryWarning
 
 #: Runs ``code`` with every file operation under the folder ``watched`` counted; SIGKILL
 #: (or KeyboardInterrupt) just before the ``N``-th.

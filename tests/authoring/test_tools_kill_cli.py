@@ -30,7 +30,8 @@ from tools_helpers import (
     write_notebook,
 )
 
-from lqe_helpers.authoring.swap import KILL_AT_STEP, FolderLock, RecoveryWarning
+from lqe_helpers.authoring.folder_lock import FolderLock
+from lqe_helpers.authoring.swap import KILL_AT_STEP, RecoveryWarning
 
 
 def notebooks(source: Path, names: tuple[str, ...], variant: str = "") -> None:

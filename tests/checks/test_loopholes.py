@@ -127,7 +127,7 @@ def enter(function: types.FunctionType) -> None:
 def test_the_walk_finds_the_packs_functions_public_and_private() -> None:
     names = {name for name, _ in FUNCTIONS}
     assert len(FUNCTIONS) > 500
-    for name in ("lqe_helpers.filter.kalman_filter", "lqe_helpers.filter._covariance_sequence",
+    for name in ("lqe_helpers.filter.kalman_filter", "lqe_helpers._engine._covariance_sequence",
                  "lqe_helpers.prediction._propagate", "lqe_helpers.scenario.Scenario.A",
                  "lqe_helpers.experiments.Tracking.positions",
                  "lqe_helpers.bias_model.equations.transition_matrix"):

@@ -19,7 +19,7 @@ from cell_runner import CellRunner, cells_up_to, saved_functions, task_comment
 from check_outcomes import assert_fails
 from test_checks_background import eyes_closed
 
-from lqe_helpers import bias_model, checks, filter, prediction
+from lqe_helpers import _engine, bias_model, checks, prediction
 from lqe_helpers.checks import CheckFailed, own_work
 from lqe_helpers.student_code import task_runs
 
@@ -214,7 +214,7 @@ def predict_with_private_propagate(P, F, G, sigma):
 
 
 def loop_over_the_packs_gains(y, A, C, Q, R, z0, P0):
-    gains = filter._covariance_sequence(len(y), A, C, Q, R, P0).gains
+    gains = _engine._covariance_sequence(len(y), A, C, Q, R, P0).gains
     z, estimates = z0, []
     for y_j, K in zip(y, gains, strict=True):
         z = A @ z + K @ (y_j - C @ A @ z)
@@ -232,7 +232,7 @@ def compensate_with_delay_signal(estimates, A, delay_steps):
     (checks.check_transition_matrix, bias_matrix_abs,
      "lqe_helpers.bias_model.equations.transition_matrix"),
     (checks.check_eyes_closed, predict_with_private_propagate, "lqe_helpers.prediction._propagate"),
-    (checks.check_filter, loop_over_the_packs_gains, "lqe_helpers.filter._covariance_sequence"),
+    (checks.check_filter, loop_over_the_packs_gains, "lqe_helpers._engine._covariance_sequence"),
     (checks.check_compensation, compensate_with_delay_signal,
      "lqe_helpers.simulation.delay_signal"),
 ])

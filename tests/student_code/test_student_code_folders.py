@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from reference_loops import lqe_filter
+from reference_loops import student_lqe_filter as lqe_filter
 
 from lqe_helpers import checks, student_code
 from lqe_helpers.checks.machinery import CheckFailed
