@@ -222,7 +222,7 @@ def test_atomic_write_many_killed_at_every_step(tmp_path):
     old = snapshot(tmp_path)
     files = {str(folder / name): f"{name} new" for folder in (first, second)
              for name in ("01.ipynb", "02.ipynb")}
-    code = ("from lqe_helpers.authoring.swap import atomic_write_many\n"
+    code = ("from lqe_helpers.authoring.folder_lock import atomic_write_many\n"
             f"atomic_write_many({files!r})")
     probe = tmp_path.parent / f"{tmp_path.name}-probe"
     shutil.copytree(tmp_path, probe)

@@ -92,7 +92,7 @@ def test_an_output_folder_beside_the_sources_is_fine(tmp_path, course):
 @pytest.mark.slow
 def test_the_pack_refuses_a_folder_another_tool_holds(tmp_path, course):
     """Two tools at once on one folder: the second stops at once with one line."""
-    from lqe_helpers.authoring.swap import FolderLock
+    from lqe_helpers.authoring.folder_lock import FolderLock
 
     out = tmp_path / "out"
     out.mkdir()
