@@ -61,8 +61,9 @@ FUNCTION_TASKS: dict[str, tuple[Callable, ...]] = {
 
 #: The pack's filter engine: eq. (5) and everything built on it (a name ending in "." is
 #: a whole module).
-FILTER_ENGINE = ("lqe_helpers.filter.", "lqe_helpers._engine.", "lqe_helpers.steady_state.",
-                 "lqe_helpers.lowpass.", "lqe_helpers.fixed_gain.",
+FILTER_ENGINE = ("lqe_helpers.filter.", "lqe_helpers._engine._covariance_sequence",
+                 "lqe_helpers._engine.filter_run", "lqe_helpers._engine.riccati",
+                 "lqe_helpers.steady_state.", "lqe_helpers.lowpass.", "lqe_helpers.fixed_gain.",
                  "lqe_helpers.bias_model.tracking.")
 
 #: The pack's delay compensation, eq. (7), and its delayed runs.

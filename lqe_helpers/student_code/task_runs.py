@@ -4,15 +4,18 @@ pack's functions it ran, which calls of the student's saved functions it made.
 A check must judge what the current task cell produced. In IPython, :func:`watch_task_cells`
 (called by :func:`~lqe_helpers.student_code.brief_errors`, which every notebook's set-up
 cell runs) registers two of IPython's events: ``pre_run_cell`` starts a :class:`TaskRun`
-for a cell whose code starts with a ``# Task:`` comment and sets a profile hook
+for every cell (a student may write a task's answer in a cell of their own, without the
+``# Task:`` comment) and sets a profile hook
 (``sys.setprofile``, chained to any hook already set) that notes every function of the
 ``lqe_helpers`` package the cell runs, at any depth; ``post_run_cell`` ends it, noting
 whether the cell completed. A function loaded with :func:`~lqe_helpers.student_code.load`
 records its calls (inputs and output) into the task cell running it (:func:`note_call`).
 
-A check finds its task cell with :func:`run_for`: the latest run of a task cell that
-defines (assigns or defs at its top level) one of the names the check cell passes it; else
-of one whose ``# Task:`` comment names one; else the latest task cell run. Outside IPython,
+A check finds its task cell with :func:`run_for`: the latest run of a cell that defines
+(assigns or defs at its top level) one of the names the check cell passes it, or of a
+still unwritten task cell (its stub) whose ``# Task:`` comment names one (the cell running
+now first: a student may call the check in the cell of the task); else of any task cell
+whose comment names one; else the latest task cell run. Outside IPython,
 or before the set-up cell ran, there is no record and :func:`run_for` returns None: the
 checks then behave as without it.
 """
@@ -20,6 +23,7 @@ checks then behave as without it.
 from __future__ import annotations
 
 import ast
+import dataclasses
 import re
 import sys
 import types
@@ -63,6 +67,9 @@ class TaskRun:
         Names its top level assigns or defines (from its code, whether or not it ran).
     mentions : frozenset of str
         Identifiers its ``# Task:`` comment names.
+    task : bool
+        Whether its code starts with a ``# Task:`` comment (any other cell is recorded
+        too, for the names it defines).
     completed : bool or None
         Whether it ran to its end without an error; None while it runs.
     not_written : bool
@@ -77,6 +84,7 @@ class TaskRun:
     source: str
     defines: frozenset[str]
     mentions: frozenset[str]
+    task: bool = True
     completed: bool | None = None
     not_written: bool = False
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
@@ -152,10 +160,9 @@ class _Record:
         source = getattr(info, "raw_cell", "") or ""
         self.cell = source
         self._stop()
-        if not is_task_cell(source):
-            return
         run = TaskRun(number=len(self.runs) + 1, source=source,
-                      defines=defined_names(source), mentions=mentioned_names(source))
+                      defines=defined_names(source), mentions=mentioned_names(source),
+                      task=is_task_cell(source))
         self.current = run
         self.previous_profile = previous = sys.getprofile()
         pack_calls = run.pack_calls
@@ -183,7 +190,7 @@ class _Record:
             return None
         sys.setprofile(self.previous_profile)
         self.previous_profile = None
-        run.pack_calls = {code: name for code, name in run.pack_calls.items()
+        run.pack_calls = {code: name for code, name in list(run.pack_calls.items())
                           if not name.startswith(__name__)}
         self.runs.append(run)
         del self.runs[:-KEPT_RUNS]
@@ -223,14 +230,23 @@ def run_for(check: str) -> TaskRun | None:
 
     None without the record (plain Python, pytest) or before any task cell ran.
     """
-    if not watching() or not _RECORD.runs:
+    if not watching():
         return None
     names = set(argument_names(_RECORD.cell, check))
-    for attribute in ("defines", "mentions"):
-        for run in reversed(_RECORD.runs):
-            if names & getattr(run, attribute):
-                return run
-    return _RECORD.runs[-1]
+    now = _RECORD.current
+    if now is not None and names & now.defines:  # the task written in the check's own cell
+        return dataclasses.replace(  # as far as it ran: its pack calls up to this check
+            now, completed=True, saved_calls=list(now.saved_calls),
+            pack_calls={code: name for code, name in list(now.pack_calls.items())
+                        if not name.startswith(__name__)})
+    for run in reversed(_RECORD.runs):
+        if names & run.defines or (run.task and run.not_written and names & run.mentions):
+            return run
+    for run in reversed(_RECORD.runs):
+        if run.task and names & run.mentions:
+            return run
+    tasks = [run for run in _RECORD.runs if run.task]
+    return tasks[-1] if tasks else None
 
 
 def missing_name_message(error: BaseException, tb: types.TracebackType | None) -> str | None:
@@ -280,9 +296,14 @@ def note_call(name: str, args: tuple, output: object) -> None:
     """Record a call of the loaded function ``name`` in the task cell running now, if any."""
     run = _RECORD.current
     if run is not None:
-        copies = tuple(arg.copy() if isinstance(arg, np.ndarray) else arg for arg in args)
+        copies = tuple(map(_copied, args))
         kept = output.copy() if isinstance(output, np.ndarray) else output
         run.saved_calls.append(SavedCall(name, copies, kept))
+
+
+@machinery_function
+def _copied(value: object) -> object:
+    return value.copy() if isinstance(value, np.ndarray) else value
 
 
 def recorded(name: str, function: Callable) -> Callable:

@@ -19,8 +19,9 @@ from cell_runner import CellRunner, cells_up_to, saved_functions, task_comment
 from check_outcomes import assert_fails
 from test_checks_background import eyes_closed
 
-from lqe_helpers import _engine, bias_model, checks, prediction
+from lqe_helpers import _engine, bias_model, checks, experiments, prediction
 from lqe_helpers.checks import CheckFailed, own_work
+from lqe_helpers.scenario import DEFAULT
 from lqe_helpers.student_code import task_runs
 
 
@@ -33,10 +34,12 @@ def folder(tmp_path, monkeypatch):
 
 
 def run_task(notebook: str, check: str, code: str | None, *,
-             watch: bool = True) -> tuple[BaseException | None, str]:
-    """The notebook's cells before ``check``'s task, the task cell (its comment, then
-    ``code``; None: the worked code), then the check cell. Returns the check cell's error
-    and what it printed."""
+             watch: bool = True, comment: bool = True,
+             before_check: str = "") -> tuple[BaseException | None, str]:
+    """The notebook's cells before ``check``'s task, the task cell (its comment unless not
+    ``comment``, then ``code``; None: the worked code), then the check cell (after
+    ``before_check``, a cell run between). Returns the check cell's error and what it
+    printed."""
     before, task, check_cell = cells_up_to(notebook, check)
     runner = CellRunner(watch=watch)
     try:
@@ -44,8 +47,11 @@ def run_task(notebook: str, check: str, code: str | None, *,
             for source in before:
                 error = runner.run(source)
                 assert error is None, (source[:200], error)
-            error = runner.run(task if code is None else task_comment(task) + code)
+            error = runner.run(task if code is None
+                               else (task_comment(task) if comment else "") + code)
         assert error is None, error
+        if before_check:
+            runner.run(before_check)
         with contextlib.redirect_stdout(io.StringIO()) as printed:
             error = runner.run(check_cell)
         return error, printed.getvalue()
@@ -86,7 +92,7 @@ LOOPHOLES = {
         "large = dataclasses.replace(DEFAULT, p0_variance=1e5)\n"
         "estimates_small = experiments.track(DEFAULT).result.estimates\n"
         "estimates_large = experiments.track(large).result.estimates\n",
-        "lqe_helpers.filter.kalman_filter"),
+        "lqe_helpers._engine.filter_run"),
     "03 Task 1, C and R from the model": (
         "03_fusion", "check_fusion",
         "from lqe_helpers import model\n"
@@ -99,7 +105,7 @@ LOOPHOLES = {
         "vision_positions = experiments.track(DEFAULT, ('vision',)).positions\n"
         "mse_fused_trial = float(metrics.mse(fused_positions, truth, burn_in))\n"
         "mse_vision_trial = float(metrics.mse(vision_positions, truth, burn_in))\n",
-        "lqe_helpers.filter.kalman_filter"),
+        "lqe_helpers._engine.filter_run"),
     "04 Task 1, R from the model": (
         "04_noisier_proprioception", "check_noisier_sense",
         "from lqe_helpers import model\n"
@@ -112,7 +118,7 @@ LOOPHOLES = {
         "late_readings = shifted.delayed_measurements[:, 0]\n"
         "delayed = shifted.delayed_estimates[:, 0]\n"
         "compensated = shifted.predictions[:, 0]\n",
-        "lqe_helpers.filter.kalman_filter"),
+        "lqe_helpers._engine.filter_run"),
     "06 Task 1, the bias model's matrices": (
         "06_bonus_bias_and_input", "check_bias_model",
         "F = bias_model.transition_matrix(dt)\n"
@@ -132,6 +138,51 @@ def test_a_task_cell_that_computes_with_the_packs_answer_fails_its_check(case, f
     assert isinstance(error, CheckFailed), error
     assert f"the task cell above runs the pack's own {named}" in str(error), str(error)
     assert printed == ""
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("case", ["00 Task 3, scenario.matched_jerk_std",
+                                  "03 Task 1, C and R from the model",
+                                  "03 Task 2, the positions of experiments.track"])
+def test_the_packs_answer_in_a_cell_without_the_task_comment_fails_too(case, folder) -> None:
+    """The student trial wrote its answers in cells of its own, without `# Task:`: every cell
+    is recorded, so the check still finds the cell that made its values."""
+    notebook, check, code, named = LOOPHOLES[case]
+    error, _printed = run_task(notebook, check, code, comment=False)
+    assert isinstance(error, CheckFailed), error
+    assert f"the task cell above runs the pack's own {named}" in str(error), str(error)
+
+
+@pytest.mark.slow
+def test_a_cell_without_the_task_comment_that_raised_is_not_judged_on_stale_values(
+        folder) -> None:
+    """The trial: a right run, then the same cell (no `# Task:`) raising at its top."""
+    notebook, check = "03_fusion", "check_fusion"
+    right = ("C = np.array([[1.0, 0, 0], [1.0, 0, 0]])\n"
+             "R = np.diag([sigma_v**2, sigma_p**2])\n")
+    error, printed = run_task(notebook, check, right, comment=False,
+                              before_check="raise ValueError('oops')\n" + right)
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "the task cell above stopped with an error" in str(error)
+
+
+@pytest.mark.slow
+def test_a_check_called_in_the_cell_of_its_task_judges_that_cell(folder) -> None:
+    notebook, check = "03_fusion", "check_fusion"
+    code = ("from lqe_helpers import model\n"
+            "C = model.observation_matrix(FUSED)\n"
+            "R = model.measurement_noise_covariance([sigma_v, sigma_p])\n")
+    before, _task, check_cell = cells_up_to(notebook, check)
+    runner = CellRunner()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            for source in before:
+                assert runner.run(source) is None
+            error = runner.run(code + check_cell)
+    finally:
+        runner.close()
+    assert isinstance(error, CheckFailed), error
+    assert "runs the pack's own lqe_helpers.model.observation_matrix" in str(error)
 
 
 @pytest.mark.slow
@@ -370,3 +421,29 @@ def test_only_the_recent_task_runs_keep_the_calls_of_saved_functions() -> None:
         assert all(len(run.saved_calls) == 1 for run in runs[1:])
     finally:
         runner.close()
+
+
+def test_a_function_task_may_read_the_scenarios_data() -> None:
+    """The trial: vision_trial reading DEFAULT.truth was refused as "the pack's solution".
+    Reading the task's data computes none of its answer; the filter must still be the
+    student's own."""
+    from reference_loops import student_lqe_filter
+
+    vision = experiments.filter_model(DEFAULT)
+    A, C, Q, z0, P0 = vision.A, vision.C, vision.Q, vision.z0, vision.P0
+
+    def vision_trial(sigma_v):
+        y = DEFAULT.truth[:, 0][:, None] + sigma_v * DEFAULT.unit_noise(sensors=("vision",))
+        return y, student_lqe_filter(y, A, C, Q, np.array([[sigma_v**2]]), z0, P0)
+
+    with contextlib.redirect_stdout(io.StringIO()) as printed:
+        checks.check_vision_trial(vision_trial)
+    assert printed.getvalue().startswith("✓ ")
+
+    def whole_state(sigma_v):
+        y = DEFAULT.truth + sigma_v * DEFAULT.unit_noise(sensors=("vision",))
+        return y, student_lqe_filter(y[:, :1], A, C, Q, np.array([[sigma_v**2]]), z0, P0)
+
+    with pytest.raises(CheckFailed) as failed:
+        checks.check_vision_trial(whole_state)
+    assert "pack's own" not in str(failed.value)
