@@ -460,7 +460,9 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
     judge_interval("difference", difference, metrics.mean_ci95(vision - fused), INTERVAL_RTOL,
                    unit="cm²", mistakes=mistakes,
                    what="the paired difference vision only − fused after the first second, "
-                        "recomputed from the task's runs")
+                        "recomputed from the task's runs",
+                   runs_of=(vision, fused, "Subtract mse_fused from mse_vision as they come "
+                                           "(run r from run r, both from the same draws)"))
     passed(f"per-run MSEs of both filters over {runs} runs match the pack's engine to "
            f"{tolerance_text(MSE_RTOL)} relative, and the paired difference vision only − "
            f"fused after the first second (mean and 95 % interval) to "

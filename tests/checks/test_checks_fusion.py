@@ -228,6 +228,8 @@ def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object]:
         mse_vision = float(metrics.mse(vision_mc.positions[0], truth, burn))
     if mistake == "swapped":
         mse_vision, mse_fused = mse_fused, mse_vision
+    if mistake == "runs not paired":   # the student trial: run r − run r−1 of the other
+        difference = metrics.mean_ci95(mse_vision - np.roll(mse_fused, 1))
     return mse_vision, mse_fused, difference
 
 
@@ -257,6 +259,7 @@ def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
                     "of 100)"),
     ("burn-in - 1", "difference is not right: it leaves out one sample too few (99 instead "
                     "of 100)"),
+    ("runs not paired", "is not right: its runs are not paired: the mean is right"),
 ])
 @pytest.mark.slow
 def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
