@@ -28,7 +28,9 @@ pytest, or before the set-up cell) a check behaves as without this module.
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import io
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -207,7 +209,16 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
             return (f"the task cell above does not run your {wanted.function}: this task is "
                     f"done with your own {wanted.function} (loaded from my_functions/). Use it "
                     f"there, run that cell, then this check again")
-        if not _produced_by(args[wanted.position], wanted, run):
+    return None
+
+
+def provenance_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
+    """Which value of ``check`` (right, as the check found) did not come from the student's
+    saved function in the task cell ``run``, or None. Asked after the check passed, so
+    that a wrong value gets its own cause (a delay with np.roll, say) first."""
+    for wanted in DRIVEN.get(check, ()):
+        if wanted.position < len(args) and not _produced_by(args[wanted.position], wanted,
+                                                            run):
             return (f"{wanted.name} is not what your {wanted.function} returned in the task "
                     f"cell above: compute it from your {wanted.function}'s output, run that "
                     f"cell, then this check again")
@@ -222,10 +233,17 @@ def judged(check: Callable) -> Callable:
     def judged_check(*args: object, **kwargs: object) -> object:
         __tracebackhide__ = True
         run = task_runs.run_for(name)
-        if run is not None:
-            problem = task_problem(name, args, run)
-            if problem is not None:
-                raise CheckFailed(problem)
-        return check(*args, **kwargs)
+        if run is None:
+            return check(*args, **kwargs)
+        problem = task_problem(name, args, run)
+        if problem is not None:
+            raise CheckFailed(problem)
+        with contextlib.redirect_stdout(io.StringIO()) as said:  # its ✓ line, if it passes
+            result = check(*args, **kwargs)
+        problem = provenance_problem(name, args, run)
+        if problem is not None:
+            raise CheckFailed(problem)
+        print(said.getvalue(), end="")
+        return result
 
     return judged_check

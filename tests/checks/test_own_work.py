@@ -447,3 +447,18 @@ def test_a_function_task_may_read_the_scenarios_data() -> None:
     with pytest.raises(CheckFailed) as failed:
         checks.check_vision_trial(whole_state)
     assert "pack's own" not in str(failed.value)
+
+
+@pytest.mark.slow
+def test_a_wrong_value_made_from_my_filter_gets_its_own_cause_first(folder) -> None:
+    """The second trial: 05's delayed made with np.roll from my_filter's output was told it
+    was "not what your my_filter returned"; the check's own cause comes first now."""
+    code = ("estimates = my_filter(y, vision.A, vision.C, vision.Q, vision.R, vision.z0, "
+            "vision.P0)\n"
+            "late_readings = simulation.delay_signal(y, steps)[:, 0]\n"
+            "delayed = np.roll(estimates[:, 0], steps)\n"
+            "compensated = compensate(estimates, vision.A, steps)[:, 0]\n")
+    error, _ = run_task("05_sensory_delay", "check_delay_signals", code)
+    assert isinstance(error, CheckFailed), error
+    assert "not what your my_filter returned" not in str(error), str(error)
+    assert str(error).startswith("delayed"), str(error)
