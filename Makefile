@@ -85,6 +85,7 @@ test-fast: $(STAMP) lint
 # Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
 notebooks: $(STAMP)
 	$(BIN)/python -m lqe_helpers.authoring.notebook_runner notebooks/*.ipynb
+	$(BIN)/python -m lqe_helpers.authoring.given_cells --source notebooks
 
 # HTML handouts in build/handouts/ (index.html; prose/ without code), executed afresh.
 handouts: $(STAMP)

@@ -308,6 +308,37 @@ def _default_sigmas(scenario: Scenario, sensors: tuple[str, ...]) -> list[float]
     return [defaults[sensor] for sensor in sensors]
 
 
+def readings(scenario: Scenario, sensors: Sequence[str] = ("vision",),
+             sigmas: Sequence[float] | np.ndarray | None = None) -> np.ndarray:
+    """The sensors' readings of the scenario's trial, unfiltered (Tutorial eq. (3)).
+
+    ``y = p + σ · noise`` on the scenario's fixed draw (run 0): the ``measurements`` of
+    :func:`track` with the same arguments, without a filter or its model.
+
+    Parameters
+    ----------
+    scenario : Scenario
+        Supplies the true path and the draw.
+    sensors : sequence of str
+        ``("vision",)`` or ``("vision", "proprioception")``.
+    sigmas : array_like, shape (m,), optional
+        Noise σ of each sensor (cm), > 0. Default: the scenario's σ_v and σ_p.
+
+    Returns
+    -------
+    numpy.ndarray, shape (n, m)
+        The readings (cm), one column per sensor.
+    """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    sensors = model.sensor_names(sensors)
+    sigmas = _sensor_sigmas("sigmas", _default_sigmas(scenario, sensors) if sigmas is None
+                            else sigmas, sensors)
+    if sigmas.ndim != 1:
+        raise ValueError(f"sigmas must be one σ per sensor {sensors}, shape "
+                         f"({len(sensors)},), got shape {sigmas.shape}: sweep σ with track")
+    return _engine.readings(scenario.truth[:, 0], scenario.unit_noise(None, sensors), sigmas)
+
+
 def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
           sigmas: Sequence[float] | np.ndarray | None = None,
           assumed_sigmas: Sequence[float] | np.ndarray | None = None,

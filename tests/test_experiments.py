@@ -305,3 +305,27 @@ def test_innovations_are_each_reading_minus_the_filters_prediction_of_it() -> No
         previous = tracking.result.estimates[j]
     np.testing.assert_allclose(innovations.covariances[0], fm.C @ fm.P0 @ fm.C.T + fm.R,
                                rtol=1e-12)
+
+
+@pytest.mark.parametrize(("sensors", "sigmas"), [(("vision",), None),
+                                                 (("vision", "proprioception"), [1.5, 4.5])])
+def test_readings_are_the_truth_plus_sigma_times_the_draw_and_tracks_measurements(sensors, sigmas):
+    """experiments.readings: eq. (3) on the scenario's draw, written out here, and the
+    same y that track filters (03's and 04's given readings, without a model to copy)."""
+    expected_sigmas = np.array(sigmas if sigmas is not None
+                               else [DEFAULT.sigma_v])
+    by_hand = (DEFAULT.truth[:, 0][:, None]
+               + expected_sigmas[None, :] * DEFAULT.unit_noise(sensors=sensors))
+    y = experiments.readings(DEFAULT, sensors, sigmas)
+    np.testing.assert_allclose(y, by_hand, rtol=0, atol=1e-12)
+    np.testing.assert_array_equal(y, experiments.track(DEFAULT, sensors, sigmas).measurements)
+
+
+@pytest.mark.parametrize(("arguments", "message"), [
+    ((DEFAULT, ("vision",), [[1.5], [4.5]]), "sigmas must be one σ per sensor"),
+    ((DEFAULT, ("vision",), [-1.0]), "sigmas"),
+    (("DEFAULT",), "scenario"),
+])
+def test_readings_refuse_bad_input_by_name(arguments, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        experiments.readings(*arguments)

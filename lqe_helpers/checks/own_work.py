@@ -14,7 +14,10 @@ Two kinds of task, two guards:
   :data:`TOP_LEVEL` lists, per check, the pack functions that compute the task's answer
   (the primitive ones: the record sees calls at any depth, so listing
   ``model.observation_matrix`` also catches ``experiments.filter_model`` and
-  ``experiments.track``); a check refuses values whose task cell ran one of them.
+  ``experiments.track``); a check refuses values whose task cell ran one of them, or drew
+  on a cell the student wrote that ran one (:func:`~lqe_helpers.student_code.task_runs.ancestry`:
+  a pack result computed in an earlier cell and copied is no more the student's own). The
+  function tasks have an entry too, for the same trail from the cell defining the function.
   :data:`DRIVEN` lists, per one-trial check of 02–05, the values the student's saved
   ``my_filter`` (and 05's ``compensate``) must have produced in the task cell: each must
   equal the output of one of that cell's recorded calls of the loaded function.
@@ -31,13 +34,14 @@ from __future__ import annotations
 import contextlib
 import functools
 import io
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..scenario import Scenario
 from ..student_code import task_runs
+from ..student_code.calling import machinery_function
 from .machinery import FUNCTION_RTOL, CheckFailed, close
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
@@ -73,6 +77,10 @@ COMPENSATION = ("lqe_helpers.prediction.predict_ahead",
                 "lqe_helpers.experiments.delay_and_compensate",
                 "lqe_helpers.experiments.DelayedTracking")
 
+#: The pack's readings, truth + σ · noise (eq. (3)).
+READINGS = ("lqe_helpers._engine.readings", "lqe_helpers.simulation.measure",
+            "lqe_helpers.experiments.readings", "lqe_helpers.experiments.track")
+
 #: Per check of a top-level task: the pack functions that compute its answer. A name is a
 #: function's qualified name (``module.qualname``): it covers the function and whatever is
 #: defined inside it (a class: its methods); a name ending in "." covers a whole module.
@@ -80,11 +88,21 @@ TOP_LEVEL: dict[str, tuple[str, ...]] = {
     # 00 Task 1: A of eq. (4)
     "check_transition_matrix": ("lqe_helpers.model.transition_matrix",
                                 "lqe_helpers.bias_model.equations.transition_matrix"),
-    # 00 Task 2: the covariance carried forward, F P Fᵀ + G σ² Gᵀ
+    # 00 Task 2: the covariance carried forward, F P Fᵀ + G σ² Gᵀ (the function, its use)
+    "check_covariance_step": ("lqe_helpers.prediction.",
+                              "lqe_helpers._matrices.input_noise_covariance",
+                              "lqe_helpers.model.process_noise_covariance"),
     "check_eyes_closed": ("lqe_helpers.prediction.", "lqe_helpers._matrices.input_noise_covariance",
                           "lqe_helpers.model.process_noise_covariance"),
     # 00 Task 3: σ_j of each period
     "check_jerk_stds": ("lqe_helpers.scenario.matched_jerk_std",),
+    # 01 Task 1: my_filter, eq. (5); Task 2: vision_trial, the readings and my_filter on them
+    "check_filter": FILTER_ENGINE,
+    "check_vision_trial": FILTER_ENGINE + READINGS,
+    # 01 Going further: the smoother
+    "check_smoother": (*FILTER_ENGINE, "lqe_helpers.smoothing."),
+    # 05 Task 1: compensate, eq. (7)
+    "check_compensation": COMPENSATION,
     # 02 Task 1, 03 Task 2, 04 Task 2: one trial of the student's my_filter
     "check_start_of_trial": FILTER_ENGINE,
     "check_fusion_trial": FILTER_ENGINE,
@@ -145,12 +163,48 @@ def covers(entry: str, name: str) -> bool:
     return name == entry or name.startswith(f"{entry}.")
 
 
-def forbidden_calls(check: str, run: task_runs.TaskRun) -> list[str]:
-    """The pack functions of ``check``'s forbidden set that the task run ``run`` ran, in the
-    order it first ran them (the outermost first)."""
+@dataclass(frozen=True)
+class Forbidden:
+    """A function of a check's forbidden set run by a cell that made the check's values."""
+
+    name: str               # the forbidden function ("lqe_helpers._engine.filter_run")
+    entry: str              # the pack function the cell called that ran it
+    cell: task_runs.TaskRun  # the cell: the task cell or one of the student's it drew on
+
+
+def forbidden_calls(check: str, run: task_runs.TaskRun) -> list[Forbidden]:
+    """The functions of ``check``'s forbidden set run by the task run ``run`` or by a cell of
+    the student's whose values it drew on (:func:`~lqe_helpers.student_code.task_runs.ancestry`),
+    the task cell's first, each cell's in the order it first ran them."""
     entries = TOP_LEVEL.get(check, ())
-    return list(dict.fromkeys(name for name in run.pack_calls.values()
-                              if any(covers(entry, name) for entry in entries)))
+    return [Forbidden(name, cell.entries.get(name, name), cell)
+            for cell in task_runs.ancestry(run)
+            for name in dict.fromkeys(cell.pack_calls.values())
+            if any(covers(entry, name) for entry in entries)]
+
+
+def _short(name: str) -> str:
+    """A pack function's name as a notebook writes it: ``experiments.track``."""
+    return name.removeprefix("lqe_helpers.")
+
+
+def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
+    """What a check says of ``found``, run by ``run`` or by a cell it drew on."""
+    runs = (f"the pack's own {_short(found.entry)}" if found.entry == found.name else
+            f"the pack's {_short(found.entry)}, which runs its own {_short(found.name)}")
+    if found.cell.number == run.number:
+        return (f"the task cell above runs {runs}: that computes what this task asks you to "
+                f"compute yourself, from the equation, with NumPy, and with the pack's answer "
+                f"made in the same cell the check cannot tell yours from it. Take that call "
+                f"out (compare with the pack in a new cell below this check, if you like), run "
+                f"the task cell, then this check again")
+    drawn = sorted(found.cell.defines & set().union(
+        *(cell.reads for cell in task_runs.ancestry(run))))
+    names = ", ".join(drawn) or "a value"
+    return (f"the task cell above uses {names} from a cell you ran before it "
+            f"(`{found.cell.first_line[:60]}`), and that cell runs {runs}: a value the pack "
+            f"computed there and copied is not your own work. Make the values in the task cell "
+            f"with your own code, run it, then this check again")
 
 
 def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray]:
@@ -198,9 +252,7 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
                 f"cell makes, not the values of an earlier run)")
     used = forbidden_calls(check, run)
     if used:
-        return (f"the task cell above runs the pack's own {used[0]}: the task is to compute "
-                f"this yourself, from the equation, with NumPy, not to call the pack's "
-                f"solution. Change that cell, run it, then this check again")
+        return forbidden_text(used[0], run)
     for wanted in DRIVEN.get(check, ()):
         if wanted.position >= len(args):
             continue
@@ -247,3 +299,53 @@ def judged(check: Callable) -> Callable:
         return result
 
     return judged_check
+
+
+@contextlib.contextmanager
+def outputs_of(function: Callable, name: str) -> Iterator[list[object] | None]:
+    """The outputs of ``name`` (the student's ``my_filter``) while ``function`` runs.
+
+    ``function`` (the student's ``vision_trial``) reads ``name`` from its module's globals
+    (the notebook's): for the time of the ``with`` block that global is a wrapper that
+    notes each output, and it is put back afterwards whatever happens. Yields the list of
+    outputs, or None when ``function`` has no such global to watch.
+    """
+    namespace = getattr(function, "__globals__", None)
+    watched = namespace.get(name) if isinstance(namespace, dict) else None
+    if not callable(watched):
+        yield None
+        return
+    outputs: list[object] = []
+
+    def noting(*args: object, **kwargs: object) -> object:
+        output = watched(*args, **kwargs)
+        outputs.append(output.copy() if isinstance(output, np.ndarray) else output)
+        return output
+
+    noting.__name__ = noting.__qualname__ = getattr(watched, "__name__", name)
+    noting.__wrapped__ = watched  # type: ignore[attr-defined]
+    namespace[name] = machinery_function(noting)
+    try:
+        yield outputs
+    finally:
+        if namespace.get(name) is noting:
+            namespace[name] = watched
+
+
+def not_driven(value: np.ndarray, outputs: list[object] | None, name: str,
+               function: str) -> str | None:
+    """Why ``value`` (right, as the check found) is not an output of the student's ``name``
+    recorded while their ``function`` ran (:func:`outputs_of`), or None."""
+    if outputs is None or not outputs:
+        return (f"{function} does not run your {name}: the task is to filter the readings with "
+                f"your own {name} from Task 1, inside {function}. Call it there, run that "
+                f"cell, then this check again")
+    for output in outputs:
+        try:
+            output = np.asarray(output, dtype=float)
+        except (TypeError, ValueError):
+            continue
+        if output.shape == value.shape and close(value, output, FUNCTION_RTOL):
+            return None
+    return (f"the estimates {function} returns are not what your {name} returned inside it: "
+            f"return {name}'s output, run that cell, then this check again")

@@ -38,7 +38,7 @@ from .machinery import (
     time_limit_text,
     tolerance_text,
 )
-from .own_work import FUNCTION_TASKS
+from .own_work import FUNCTION_TASKS, not_driven, outputs_of
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -297,15 +297,18 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
         If the function is not written yet, fails (a shape error names the (n, n) readings
         of ``truth + σ_v · noise``), does not return two arrays of the right shapes, runs
         the pack's engine, or computes other numbers; the message names the likely cause:
-        σ_v² or no σ_v in the readings, σ_v or σ_v⁴ in R, the other noise level's R.
+        σ_v² or no σ_v in the readings, σ_v or σ_v⁴ in R, the other noise level's R. Right
+        estimates must also be what the student's ``my_filter`` returned inside the call
+        (:func:`~lqe_helpers.checks.own_work.outputs_of`): results kept from elsewhere fail.
     """
     name = require_callable(vision_trial, "vision_trial", "check_vision_trial")
     n = DEFAULT.n_steps
     for sigma in SIGMAS_V:
         right = _trial(sigma)
-        output = call_student(vision_trial, sigma, name=name, where=f"σ_v = {sigma:g} cm",
-                              arg_names=_TRIAL_ARGS, shape_hint=_TRIAL_SHAPE_HINT,
-                              allow=FUNCTION_TASKS["vision_trial"])
+        with outputs_of(vision_trial, "my_filter") as filtered:
+            output = call_student(vision_trial, sigma, name=name, where=f"σ_v = {sigma:g} cm",
+                                  arg_names=_TRIAL_ARGS, shape_hint=_TRIAL_SHAPE_HINT,
+                                  allow=FUNCTION_TASKS["vision_trial"])
         y, estimates = _trial_output(output, name, sigma)
         if np.shape(y) == (n, 3) and np.shape(estimates) == (n, 1):
             raise CheckFailed(f"{name}({sigma:g}) returns the estimates first and the readings "
@@ -330,6 +333,9 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
               what="the pack's engine on these readings with R = [[σ_v²]]",
               hint="my_filter passed its check, so look at what vision_trial gives it: y, "
                    "A, C = [[1, 0, 0]], Q, R = [[σ_v²]], z0 and P0")
+        problem = not_driven(estimates, filtered, "my_filter", f"{name}({sigma:g})")
+        if problem is not None:
+            raise CheckFailed(problem)
     passed(f"{name} at σ_v = {' and '.join(f'{s:g}' for s in SIGMAS_V)} cm: the readings "
            f"truth + σ_v · noise and the estimates with R = [[σ_v²]] match the pack's engine "
            f"on the scenario's draw to {tolerance_text(FUNCTION_RTOL)} of the largest value, "

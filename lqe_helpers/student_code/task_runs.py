@@ -15,7 +15,11 @@ A check finds its task cell with :func:`run_for`: the latest run of a cell that 
 (assigns or defs at its top level) one of the names the check cell passes it, or of a
 still unwritten task cell (its stub) whose ``# Task:`` comment names one (the cell running
 now first: a student may call the check in the cell of the task); else of any task cell
-whose comment names one; else the latest task cell run. Outside IPython,
+whose comment names one; else the latest task cell run. :func:`ancestry` follows a task
+run's values back through the cells the student wrote: a value made by the pack's solution
+in an earlier cell of theirs and copied into the task cell is theirs no more than if the
+task cell had called the pack itself. The cells the pack gives
+(:mod:`~lqe_helpers.student_code.given_cells`) end that trail. Outside IPython,
 or before the set-up cell ran, there is no record and :func:`run_for` returns None: the
 checks then behave as without it.
 """
@@ -33,6 +37,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .calling import in_pack, machinery_function, pack_name
+from .given_cells import is_given
 
 #: How a task cell starts (after blank lines).
 TASK_PREFIX = "# Task:"
@@ -70,12 +75,19 @@ class TaskRun:
     task : bool
         Whether its code starts with a ``# Task:`` comment (any other cell is recorded
         too, for the names it defines).
+    given : bool
+        Whether its code is a cell the pack gives, unchanged (not the student's).
+    reads : frozenset of str
+        Names its code reads before it gives them a value (:func:`read_names`).
     completed : bool or None
         Whether it ran to its end without an error; None while it runs.
     not_written : bool
         Whether it stopped with ``NotImplementedError`` (a student edition's stub).
     pack_calls : dict
         Qualified name of each function of the pack it ran, by code object.
+    entries : dict
+        For each of those names, the function of the pack the cell itself called that ran
+        it (the same name for a function the cell called).
     saved_calls : list of SavedCall
         Its calls of the student's loaded functions.
     """
@@ -85,10 +97,18 @@ class TaskRun:
     defines: frozenset[str]
     mentions: frozenset[str]
     task: bool = True
+    given: bool = False
+    reads: frozenset[str] = frozenset()
     completed: bool | None = None
     not_written: bool = False
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
+    entries: dict[str, str] = field(default_factory=dict)
     saved_calls: list[SavedCall] = field(default_factory=list)
+
+    @property
+    def first_line(self) -> str:
+        """Its first line of code or comment (for a message)."""
+        return next((line.strip() for line in self.source.splitlines() if line.strip()), "")
 
     def ran(self, qualified_names: frozenset[str] | set[str]) -> list[str]:
         """Which of ``qualified_names`` (``"lqe_helpers.model.observation_matrix"``) it ran."""
@@ -111,10 +131,124 @@ def defined_names(source: str) -> frozenset[str]:
         if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
             names.add(node.name)
             continue
-        for child in ast.walk(node):
+        for child in _outer_nodes(node):
             if isinstance(child, ast.Name) and isinstance(child.ctx, ast.Store):
                 names.add(child.id)
     return frozenset(names)
+
+
+#: Nodes whose names live in a scope of their own (a comprehension's loop variable).
+_OWN_SCOPE = (ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp, ast.Lambda,
+              ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
+
+
+def _outer_nodes(node: ast.AST) -> list[ast.AST]:
+    """``node`` and the nodes below it, but not inside a scope of their own."""
+    found, stack = [], [node]
+    while stack:
+        current = stack.pop()
+        found.append(current)
+        stack.extend(child for child in ast.iter_child_nodes(current)
+                     if not isinstance(child, _OWN_SCOPE))
+    return found
+
+
+class _ReadOrder(ast.NodeVisitor):
+    """Visits a cell's code in the order it runs (a value before the name it is given), noting
+    whether each name is first read or first given a value."""
+
+    def __init__(self) -> None:
+        self.first_read: dict[str, bool] = {}
+
+    def note(self, name: str, read: bool) -> None:
+        self.first_read.setdefault(name, read)
+
+    def visit_Name(self, node: ast.Name) -> None:
+        self.note(node.id, isinstance(node.ctx, ast.Load))
+
+    def visit_arg(self, node: ast.arg) -> None:
+        self.note(node.arg, False)
+
+    def visit_alias(self, node: ast.alias) -> None:
+        self.note((node.asname or node.name).split(".")[0], False)
+
+    def _value_first(self, node: ast.AST, value: ast.AST | None, targets: list[ast.AST]) -> None:
+        if isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Name):
+            self.note(node.target.id, True)
+        if value is not None:
+            self.visit(value)
+        for target in targets:
+            self.visit(target)
+
+    def visit_Assign(self, node: ast.Assign) -> None:
+        self._value_first(node, node.value, node.targets)
+
+    def visit_AugAssign(self, node: ast.AugAssign) -> None:
+        self._value_first(node, node.value, [node.target])
+
+    def visit_AnnAssign(self, node: ast.AnnAssign) -> None:
+        self._value_first(node, node.value, [node.target])
+
+    def visit_NamedExpr(self, node: ast.NamedExpr) -> None:
+        self._value_first(node, node.value, [node.target])
+
+    def visit_For(self, node: ast.For | ast.AsyncFor) -> None:
+        self._value_first(node, node.iter, [node.target, *node.body, *node.orelse])
+
+    visit_AsyncFor = visit_For
+
+    def visit_comprehension(self, node: ast.comprehension) -> None:
+        self._value_first(node, node.iter, [node.target, *node.ifs])
+
+    def _comprehension(self, node: ast.AST, results: list[ast.AST]) -> None:
+        for generator in node.generators:  # type: ignore[attr-defined]
+            self.visit(generator)
+        for result in results:
+            self.visit(result)
+
+    def visit_ListComp(self, node: ast.ListComp) -> None:
+        self._comprehension(node, [node.elt])
+
+    visit_SetComp = visit_GeneratorExp = visit_ListComp
+
+    def visit_DictComp(self, node: ast.DictComp) -> None:
+        self._comprehension(node, [node.key, node.value])
+
+    def _definition(self, node: ast.AST, name: str | None) -> None:
+        for decorator in getattr(node, "decorator_list", ()):
+            self.visit(decorator)
+        if name is not None:
+            self.note(name, False)
+        for field_name in ("bases", "keywords", "args", "body"):
+            value = getattr(node, field_name, None)
+            for child in value if isinstance(value, list) else [value] if value else []:
+                self.visit(child)
+
+    def visit_FunctionDef(self, node: ast.FunctionDef | ast.AsyncFunctionDef) -> None:
+        self._definition(node, node.name)
+
+    visit_AsyncFunctionDef = visit_FunctionDef
+
+    def visit_ClassDef(self, node: ast.ClassDef) -> None:
+        self._definition(node, node.name)
+
+    def visit_Lambda(self, node: ast.Lambda) -> None:
+        self._definition(node, None)
+
+
+def read_names(source: str) -> frozenset[str]:
+    """Names ``source`` reads before it gives them a value (empty if it does not parse).
+
+    The code is taken in the order it runs (``x = f(x)`` reads ``x``); a function's body
+    counts where the function is defined, its parameters as given.
+    """
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return frozenset()
+    order = _ReadOrder()
+    order.visit(tree)
+    return frozenset(name for name, read in order.first_read.items() if read)
 
 
 def mentioned_names(source: str) -> frozenset[str]:
@@ -160,20 +294,31 @@ class _Record:
         source = getattr(info, "raw_cell", "") or ""
         self.cell = source
         self._stop()
-        run = TaskRun(number=len(self.runs) + 1, source=source,
-                      defines=defined_names(source), mentions=mentioned_names(source),
-                      task=is_task_cell(source))
+        number = self.runs[-1].number + 1 if self.runs else 1
+        run = TaskRun(number=number, source=source, defines=defined_names(source),
+                      mentions=mentioned_names(source), task=is_task_cell(source),
+                      given=is_given(source), reads=read_names(source))
         self.current = run
         self.previous_profile = previous = sys.getprofile()
-        pack_calls = run.pack_calls
+        pack_calls, entries = run.pack_calls, run.entries
+        entry = ["", 0]  # the pack function the cell itself called last; pack frames open
 
         def noting(frame: types.FrameType, event: str, arg: object) -> None:
             if previous is not None:
                 previous(frame, event, arg)
             if event == "call":
                 code = frame.f_code
-                if code not in pack_calls and in_pack(code.co_filename):
-                    pack_calls[code] = pack_name(frame)
+                name = pack_calls.get(code)
+                if name is None:
+                    if not in_pack(code.co_filename):
+                        return
+                    name = pack_calls[code] = pack_name(frame)
+                if not entry[1]:
+                    entry[0] = name
+                entry[1] += 1
+                entries.setdefault(name, entry[0])
+            elif event == "return" and frame.f_code in pack_calls:
+                entry[1] = max(entry[1] - 1, 0)
 
         sys.setprofile(noting)
 
@@ -247,6 +392,31 @@ def run_for(check: str) -> TaskRun | None:
             return run
     tasks = [run for run in _RECORD.runs if run.task]
     return tasks[-1] if tasks else None
+
+
+def ancestry(run: TaskRun) -> list[TaskRun]:
+    """``run`` and the cells of the student's whose values it draws on, nearest first.
+
+    For each name a run reads (:attr:`TaskRun.reads`), the runs before it that define the
+    name, latest first, up to the first that completed; then the same for those runs in
+    turn. A cell the pack gives (:attr:`TaskRun.given`) ends the trail: its values are the
+    notebook's own.
+    """
+    found, queue = [run], [run]
+    seen = {run.number}
+    while queue:
+        reader = queue.pop(0)
+        for name in sorted(reader.reads):
+            for earlier in reversed(_RECORD.runs):
+                if earlier.number >= reader.number or name not in earlier.defines:
+                    continue
+                if not earlier.given and earlier.number not in seen:
+                    seen.add(earlier.number)
+                    found.append(earlier)
+                    queue.append(earlier)
+                if earlier.completed:
+                    break
+    return found
 
 
 def missing_name_message(error: BaseException, tb: types.TracebackType | None) -> str | None:

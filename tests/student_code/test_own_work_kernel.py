@@ -43,7 +43,7 @@ def cells(tmp_path_factory):
 def test_a_task_cell_that_runs_the_packs_answer_fails_its_check_naming_it(cells) -> None:
     ename, shown = error_of(cells[2])
     assert ename == "CheckFailed"
-    assert "the task cell above runs the pack's own lqe_helpers.model.observation_matrix" in shown
+    assert "the task cell above runs the pack's own model.observation_matrix" in shown
     assert "lqe_helpers/" not in shown
 
 
