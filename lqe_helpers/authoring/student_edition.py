@@ -156,7 +156,9 @@ STUDENT_NOTE = (
     "asks, and run the notebook from the top. Write your answers where it says "
     "**Your answer**. An explorer runs once the first code cell has run; one that runs "
     "your own function (`my_filter` from notebook 01, `compensate`) shows its figure once "
-    "that function passes its check, and until then says what to do."
+    "that function passes its check, and until then says what to do. A check judges your "
+    "own code: values made by the pack's own function for that task (in the task cell, or "
+    "in a cell of yours run before it) are refused, and the message says how to start again."
 )
 
 

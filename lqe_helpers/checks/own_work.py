@@ -34,6 +34,7 @@ from __future__ import annotations
 import contextlib
 import functools
 import io
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
@@ -188,10 +189,15 @@ def _short(name: str) -> str:
     return name.removeprefix("lqe_helpers.")
 
 
+def _runs(entry: str, name: str) -> str:
+    """"the pack's own X", or "the pack's X, which runs its own Y" for an inner function."""
+    return (f"the pack's own {_short(entry)}" if entry == name else
+            f"the pack's {_short(entry)}, which runs its own {_short(name)}")
+
+
 def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
     """What a check says of ``found``, run by ``run`` or by a cell it drew on."""
-    runs = (f"the pack's own {_short(found.entry)}" if found.entry == found.name else
-            f"the pack's {_short(found.entry)}, which runs its own {_short(found.name)}")
+    runs = _runs(found.entry, found.name)
     if found.cell.number == run.number:
         return (f"the task cell above runs {runs}: that computes what this task asks you to "
                 f"compute yourself, from the equation, with NumPy, and with the pack's answer "
@@ -277,6 +283,63 @@ def provenance_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str |
     return None
 
 
+def _leaves(value: object, depth: int = 2) -> list[np.ndarray]:
+    """The numbers and numeric arrays in ``value`` (its items, to ``depth`` levels)."""
+    if isinstance(value, dict):
+        items = list(value.values())
+    elif isinstance(value, (list, tuple)):
+        items = list(value)
+    else:
+        try:
+            array = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            return []
+        return [array] if array.size else []
+    if depth == 0:
+        return []
+    return [leaf for item in items[:100] for leaf in _leaves(item, depth - 1)]
+
+
+#: Code that can carry a value out of a cell without a name: files, globals, attributes.
+_HIDDEN_CHANNEL = re.compile(
+    r"\b(open|save|savez|savez_compressed|savetxt|tofile|dump|dumps|pickle|shelve|json|"
+    r"globals|locals|vars|setattr|exec|eval|builtins|__builtins__|__dict__|modules|"
+    r"write_text|write_bytes|store)\b|^\s*[%!]|\.[A-Za-z_]\w*\s*=[^=]", re.MULTILINE)
+
+
+def copied_result(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
+    """Which value of ``check`` (right, as the check found) equals a result of its forbidden
+    set that a cell of the student's computed before the task cell, or None.
+
+    The trail of :func:`forbidden_calls` follows names; a value can also travel through a
+    file, a module's attribute or ``globals()``. What the check is given is compared, number
+    for number, with what the pack's functions of the task returned in the student's earlier
+    cells; an earlier version of the task cell (it defines a name the check is given, and
+    has no code that could carry a value out of it otherwise) is replaced by this one. A
+    one-trial check (:data:`DRIVEN`) is left to the record of the student's function.
+    """
+    entries = TOP_LEVEL.get(check, ())
+    if check in DRIVEN or not entries:
+        return None
+    given = task_runs.argument_names(task_runs.current_cell(), check)
+    earlier = [(cell, name, result) for cell, name, result in task_runs.earlier_results(run)
+               if any(covers(entry, name) for entry in entries)
+               and (not cell.defines & set(given) or _HIDDEN_CHANNEL.search(cell.source))]
+    for position, value in enumerate(args):
+        for leaf in _leaves(value):
+            for cell, name, result in earlier:
+                if leaf.shape == result.shape and np.allclose(leaf, result, rtol=1e-12,
+                                                              atol=0.0):
+                    what = given[position] if position < len(given) else "a value"
+                    return (f"{what} equals what {_runs(cell.entries.get(name, name), name)} "
+                            f"returned in a cell you ran before the task cell "
+                            f"(`{cell.first_line[:60]}`): the check cannot tell it from the "
+                            f"pack's answer. If you computed it yourself, restart the kernel "
+                            f"(Kernel → Restart Kernel), run the cells above the task without "
+                            f"that one, then the task cell and this check")
+    return None
+
+
 def judged(check: Callable) -> Callable:
     """``check`` refusing values that are not its current task cell's own work (see above)."""
     name = check.__name__
@@ -292,7 +355,7 @@ def judged(check: Callable) -> Callable:
             raise CheckFailed(problem)
         with contextlib.redirect_stdout(io.StringIO()) as said:  # its ✓ line, if it passes
             result = check(*args, **kwargs)
-        problem = provenance_problem(name, args, run)
+        problem = provenance_problem(name, args, run) or copied_result(name, args, run)
         if problem is not None:
             raise CheckFailed(problem)
         print(said.getvalue(), end="")

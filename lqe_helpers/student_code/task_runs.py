@@ -26,9 +26,7 @@ checks then behave as without it.
 
 from __future__ import annotations
 
-import ast
 import dataclasses
-import re
 import sys
 import types
 from collections.abc import Callable
@@ -37,13 +35,22 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .calling import in_pack, machinery_function, pack_name
+from .cell_code import (
+    argument_names,
+    calls_a_check,
+    defined_names,
+    is_task_cell,
+    mentioned_names,
+    read_names,
+)
 from .given_cells import is_given
-
-#: How a task cell starts (after blank lines).
-TASK_PREFIX = "# Task:"
 
 #: Task runs kept (the most recent last).
 KEPT_RUNS = 200
+#: Of each cell of the student's, at most this many small results of the pack's functions
+#: are kept (:attr:`TaskRun.results`), each of at most :data:`RESULT_SIZE` numbers.
+RESULTS_KEPT = 100
+RESULT_SIZE = 64
 #: Of these, the most recent whose calls of the student's saved functions (their inputs and
 #: outputs, copied) are kept; older runs forget them, so memory stays bounded.
 RUNS_WITH_CALLS = 20
@@ -88,6 +95,10 @@ class TaskRun:
     entries : dict
         For each of those names, the function of the pack the cell itself called that ran
         it (the same name for a function the cell called).
+    results : list of (str, numpy.ndarray)
+        In a cell of the student's (not given): the small numeric results (numbers and
+        arrays of at most :data:`RESULT_SIZE` numbers, copied) of the pack's functions it
+        ran, each with the function's name, at most :data:`RESULTS_KEPT`.
     saved_calls : list of SavedCall
         Its calls of the student's loaded functions.
     """
@@ -103,6 +114,7 @@ class TaskRun:
     not_written: bool = False
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
     entries: dict[str, str] = field(default_factory=dict)
+    results: list[tuple[str, np.ndarray]] = field(default_factory=list)
     saved_calls: list[SavedCall] = field(default_factory=list)
 
     @property
@@ -113,171 +125,6 @@ class TaskRun:
     def ran(self, qualified_names: frozenset[str] | set[str]) -> list[str]:
         """Which of ``qualified_names`` (``"lqe_helpers.model.observation_matrix"``) it ran."""
         return sorted(name for name in set(self.pack_calls.values()) if name in qualified_names)
-
-
-def is_task_cell(source: str) -> bool:
-    """Whether a cell's code starts with a ``# Task:`` comment."""
-    return source.lstrip().startswith(TASK_PREFIX)
-
-
-def defined_names(source: str) -> frozenset[str]:
-    """Names assigned or defined at the top level of ``source`` (empty if it does not parse)."""
-    try:
-        tree = ast.parse(source)
-    except (SyntaxError, ValueError):
-        return frozenset()
-    names: set[str] = set()
-    for node in tree.body:
-        if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
-            names.add(node.name)
-            continue
-        for child in _outer_nodes(node):
-            if isinstance(child, ast.Name) and isinstance(child.ctx, ast.Store):
-                names.add(child.id)
-    return frozenset(names)
-
-
-#: Nodes whose names live in a scope of their own (a comprehension's loop variable).
-_OWN_SCOPE = (ast.ListComp, ast.SetComp, ast.DictComp, ast.GeneratorExp, ast.Lambda,
-              ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)
-
-
-def _outer_nodes(node: ast.AST) -> list[ast.AST]:
-    """``node`` and the nodes below it, but not inside a scope of their own."""
-    found, stack = [], [node]
-    while stack:
-        current = stack.pop()
-        found.append(current)
-        stack.extend(child for child in ast.iter_child_nodes(current)
-                     if not isinstance(child, _OWN_SCOPE))
-    return found
-
-
-class _ReadOrder(ast.NodeVisitor):
-    """Visits a cell's code in the order it runs (a value before the name it is given), noting
-    whether each name is first read or first given a value."""
-
-    def __init__(self) -> None:
-        self.first_read: dict[str, bool] = {}
-
-    def note(self, name: str, read: bool) -> None:
-        self.first_read.setdefault(name, read)
-
-    def visit_Name(self, node: ast.Name) -> None:
-        self.note(node.id, isinstance(node.ctx, ast.Load))
-
-    def visit_arg(self, node: ast.arg) -> None:
-        self.note(node.arg, False)
-
-    def visit_alias(self, node: ast.alias) -> None:
-        self.note((node.asname or node.name).split(".")[0], False)
-
-    def _value_first(self, node: ast.AST, value: ast.AST | None, targets: list[ast.AST]) -> None:
-        if isinstance(node, ast.AugAssign) and isinstance(node.target, ast.Name):
-            self.note(node.target.id, True)
-        if value is not None:
-            self.visit(value)
-        for target in targets:
-            self.visit(target)
-
-    def visit_Assign(self, node: ast.Assign) -> None:
-        self._value_first(node, node.value, node.targets)
-
-    def visit_AugAssign(self, node: ast.AugAssign) -> None:
-        self._value_first(node, node.value, [node.target])
-
-    def visit_AnnAssign(self, node: ast.AnnAssign) -> None:
-        self._value_first(node, node.value, [node.target])
-
-    def visit_NamedExpr(self, node: ast.NamedExpr) -> None:
-        self._value_first(node, node.value, [node.target])
-
-    def visit_For(self, node: ast.For | ast.AsyncFor) -> None:
-        self._value_first(node, node.iter, [node.target, *node.body, *node.orelse])
-
-    visit_AsyncFor = visit_For
-
-    def visit_comprehension(self, node: ast.comprehension) -> None:
-        self._value_first(node, node.iter, [node.target, *node.ifs])
-
-    def _comprehension(self, node: ast.AST, results: list[ast.AST]) -> None:
-        for generator in node.generators:  # type: ignore[attr-defined]
-            self.visit(generator)
-        for result in results:
-            self.visit(result)
-
-    def visit_ListComp(self, node: ast.ListComp) -> None:
-        self._comprehension(node, [node.elt])
-
-    visit_SetComp = visit_GeneratorExp = visit_ListComp
-
-    def visit_DictComp(self, node: ast.DictComp) -> None:
-        self._comprehension(node, [node.key, node.value])
-
-    def _definition(self, node: ast.AST, name: str | None) -> None:
-        for decorator in getattr(node, "decorator_list", ()):
-            self.visit(decorator)
-        if name is not None:
-            self.note(name, False)
-        for field_name in ("bases", "keywords", "args", "body"):
-            value = getattr(node, field_name, None)
-            for child in value if isinstance(value, list) else [value] if value else []:
-                self.visit(child)
-
-    def visit_FunctionDef(self, node: ast.FunctionDef | ast.AsyncFunctionDef) -> None:
-        self._definition(node, node.name)
-
-    visit_AsyncFunctionDef = visit_FunctionDef
-
-    def visit_ClassDef(self, node: ast.ClassDef) -> None:
-        self._definition(node, node.name)
-
-    def visit_Lambda(self, node: ast.Lambda) -> None:
-        self._definition(node, None)
-
-
-def read_names(source: str) -> frozenset[str]:
-    """Names ``source`` reads before it gives them a value (empty if it does not parse).
-
-    The code is taken in the order it runs (``x = f(x)`` reads ``x``); a function's body
-    counts where the function is defined, its parameters as given.
-    """
-    try:
-        tree = ast.parse(source)
-    except (SyntaxError, ValueError):
-        return frozenset()
-    order = _ReadOrder()
-    order.visit(tree)
-    return frozenset(name for name, read in order.first_read.items() if read)
-
-
-def mentioned_names(source: str) -> frozenset[str]:
-    """Identifiers in the comment lines at the top of ``source`` (its ``# Task:`` block)."""
-    words: set[str] = set()
-    for line in source.lstrip().splitlines():
-        if not line.lstrip().startswith("#"):
-            break
-        words.update(re.findall(r"[A-Za-z_][A-Za-z_0-9]*", line))
-    return frozenset(words)
-
-
-def argument_names(source: str, check: str) -> list[str]:
-    """The bare names passed to a call of ``check`` (``checks.check_x(C, R)``) in ``source``."""
-    try:
-        tree = ast.parse(source)
-    except (SyntaxError, ValueError):
-        return []
-    names: list[str] = []
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Call):
-            called = node.func
-            called_name = (called.attr if isinstance(called, ast.Attribute)
-                           else called.id if isinstance(called, ast.Name) else "")
-            if called_name == check:
-                arguments = [*node.args, *(keyword.value for keyword in node.keywords)]
-                names += [argument.id for argument in arguments
-                          if isinstance(argument, ast.Name)]
-    return names
 
 
 class _Record:
@@ -300,7 +147,8 @@ class _Record:
                       given=is_given(source), reads=read_names(source))
         self.current = run
         self.previous_profile = previous = sys.getprofile()
-        pack_calls, entries = run.pack_calls, run.entries
+        pack_calls, entries, results = run.pack_calls, run.entries, run.results
+        keep_results = not run.given
         entry = ["", 0]  # the pack function the cell itself called last; pack frames open
 
         def noting(frame: types.FrameType, event: str, arg: object) -> None:
@@ -319,6 +167,10 @@ class _Record:
                 entries.setdefault(name, entry[0])
             elif event == "return" and frame.f_code in pack_calls:
                 entry[1] = max(entry[1] - 1, 0)
+                if keep_results and len(results) < RESULTS_KEPT:
+                    kept = _small_result(arg)
+                    if kept is not None:
+                        results.append((pack_calls[frame.f_code], kept))
 
         sys.setprofile(noting)
 
@@ -394,6 +246,24 @@ def run_for(check: str) -> TaskRun | None:
     return tasks[-1] if tasks else None
 
 
+def _small_result(value: object) -> np.ndarray | None:
+    """A copy of ``value`` as a float array if it is a number or a small numeric array."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(
+            value, (int, float, np.number, np.ndarray)):
+        return None
+    if isinstance(value, np.ndarray) and (value.size > RESULT_SIZE or value.dtype.kind
+                                          not in "iuf"):
+        return None
+    return np.array(value, dtype=float)
+
+
+def earlier_results(run: TaskRun) -> list[tuple[TaskRun, str, np.ndarray]]:
+    """The results kept (:attr:`TaskRun.results`) by the cells of the student's run before
+    ``run``: (cell, function, result)."""
+    return [(earlier, name, result) for earlier in _RECORD.runs
+            if earlier.number < run.number for name, result in earlier.results]
+
+
 def ancestry(run: TaskRun) -> list[TaskRun]:
     """``run`` and the cells of the student's whose values it draws on, nearest first.
 
@@ -448,17 +318,6 @@ def missing_name_message(error: BaseException, tb: types.TracebackType | None) -
                         f"then this check")
     return (f"name '{name}' is not defined: no cell run so far makes it. Run the cells above "
             f"this check in order, its task cell too, then this check again")
-
-
-def calls_a_check(source: str) -> bool:
-    """Whether ``source`` calls a function named ``check_…``."""
-    try:
-        tree = ast.parse(source)
-    except (SyntaxError, ValueError):
-        return False
-    return any(isinstance(node, ast.Call) and (
-        getattr(node.func, "attr", "") or getattr(node.func, "id", "")).startswith("check_")
-        for node in ast.walk(tree))
 
 
 @machinery_function

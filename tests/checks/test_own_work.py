@@ -519,13 +519,73 @@ def test_the_packs_answer_made_in_an_earlier_cell_and_copied_fails(case, through
 
 
 @pytest.mark.slow
-def test_the_packs_answer_run_in_an_earlier_cell_but_not_used_is_no_reason_to_refuse(folder):
-    """A student may look at the pack's answer in a cell of their own; a task cell that does
-    not use its values is judged on its own (no false refusal)."""
+def test_the_pack_run_in_an_earlier_cell_on_other_inputs_is_no_reason_to_refuse(folder):
+    """A student may try the pack's functions in a cell of their own; a task cell that does
+    not use their values, which are not the task's answer, is judged on its own."""
     look = ("from lqe_helpers import model\n"
-            "print(model.measurement_noise_covariance([sigma_v, sigma_p]))\n"
-            "seen = model.observation_matrix(FUSED)\n")
+            "print(model.measurement_noise_covariance([1.0, 2.0]))\n"
+            "seen = model.observation_matrix(('vision',))\n")
     error, printed = run_task("03_fusion", "check_fusion", None, earlier=(look,))
+    assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+#: Ways a value leaves a cell without a name the task cell reads (03 Task 1's C and R).
+HIDDEN_CHANNELS = {
+    "a file": ("from lqe_helpers import model\n"
+               "np.save('kept_c.npy', model.observation_matrix(FUSED))\n"
+               "np.save('kept_r.npy', model.measurement_noise_covariance([sigma_v, sigma_p]))\n",
+               "C = np.load('kept_c.npy')\nR = np.load('kept_r.npy')\n"),
+    "a module's attribute": (
+        "from lqe_helpers import model\n"
+        "np.kept = (model.observation_matrix(FUSED),\n"
+        "           model.measurement_noise_covariance([sigma_v, sigma_p]))\n",
+        "C, R = (value.copy() for value in np.kept)\n"),
+    "globals()": ("from lqe_helpers import model\n"
+                  "globals()['C'] = model.observation_matrix(FUSED)\n"
+                  "globals().update(R=model.measurement_noise_covariance([sigma_v, sigma_p]))\n",
+                  "C = C * 1.0\nR = R + 0.0\n"),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("channel", ["a file", "a module's attribute", "globals()"])
+def test_the_packs_answer_passed_on_without_a_name_fails_too(channel, folder):
+    """Names are not the only way a value travels between cells: what the check is given is
+    compared with what the task's forbidden functions returned in the student's earlier
+    cells. The message says what is true and how to start again."""
+    earlier, task = HIDDEN_CHANNELS[channel]
+    error, printed = run_task("03_fusion", "check_fusion", task, earlier=(earlier,),
+                              watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)  # the right values
+    error, printed = run_task("03_fusion", "check_fusion", task, earlier=(earlier,))
+    assert isinstance(error, CheckFailed), error
+    assert ("C equals what the pack's model.observation_matrix, which runs its own "
+            "_matrices.observation returned in a cell you ran before the task cell") in str(error)
+    assert "restart the kernel" in str(error)
+    assert printed == ""
+
+
+@pytest.mark.slow
+def test_the_packs_answer_looked_at_before_the_task_cell_is_refused_with_the_way_out(folder):
+    """The policy the student edition's note states: values equal to what the task's pack
+    function returned in a cell of the student's before the task cell cannot be told from
+    it; the message says so, and how to start again."""
+    look = ("from lqe_helpers import model\n"
+            "print(model.measurement_noise_covariance([sigma_v, sigma_p]))\n")
+    error, _printed = run_task("03_fusion", "check_fusion", None, earlier=(look,))
+    assert isinstance(error, CheckFailed), error
+    assert str(error).startswith("R equals what the pack's"), error
+    assert "model.measurement_noise_covariance" in str(error), error
+    assert "restart the kernel" in str(error)
+
+
+@pytest.mark.slow
+def test_the_packs_answer_looked_at_after_the_task_cell_is_no_reason_to_refuse(folder):
+    """Comparing with the pack once the task cell has run, then running the check (again),
+    judges the task cell, which ran before the comparison."""
+    look = ("from lqe_helpers import model\n"
+            "print(model.measurement_noise_covariance([sigma_v, sigma_p]))\n")
+    error, printed = run_task("03_fusion", "check_fusion", None, before_check=look)
     assert error is None and printed.startswith("✓ "), (error, printed)
 
 
