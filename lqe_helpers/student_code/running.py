@@ -30,7 +30,8 @@ traceback (their own lines) is kept for the message. What it cannot stop: one lo
 frame, with no call anywhere: nothing is dropped or called, so the trace is off from its
 handler's first raise until the next 50 ms tick, whose raise lands in the inner ``try``
 again. A deep recursion that catches everything is stopped, but it may take a few seconds
-to unwind (the 50 ms tick must land where there is room to run the handler).
+to unwind (the 50 ms tick must land where there is room to run the handler); off the main
+thread (:func:`run_in_thread`), where no tick runs inside the worker, it is left behind.
 """
 
 from __future__ import annotations
@@ -67,7 +68,10 @@ class TimeIsUp(BaseException):
 
     def __del__(self) -> None:
         if self.rearm is not None:
-            self.rearm()
+            try:
+                self.rearm()
+            except TimeIsUp:  # sent to a worker thread meanwhile: it is sent again
+                pass
 
 
 class _Stopper:
@@ -234,10 +238,13 @@ def run_in_thread(function: Callable, args: tuple, limit: float) -> tuple[str, o
     """``function(*args)`` in a worker thread, stopped after ``limit`` s (see the module).
 
     The worker runs under the trace function and profile hook of its :class:`_Stopper`,
-    which do nothing (no line is traced) until the time is up. Then the worker is sent
-    :class:`TimeIsUp` once and its frames are traced, every 50 ms, as in
-    :func:`run_with_alarm`. A worker that has not ended 1 s later (stuck in one long C call,
-    say) is left to finish in the background while the time-out is reported.
+    which do nothing (no line is traced) until the time is up. Then the worker is given
+    room to recurse (:meth:`_Stopper.give_room`) and sent :class:`TimeIsUp`, and every
+    50 ms its frames are traced and it is sent :class:`TimeIsUp` again, as the timer of
+    :func:`run_with_alarm` repeats. A worker that has not ended 1 s later (stuck in one long
+    C call, or a deep recursion that catches everything: another thread cannot put back its
+    trace) is left to finish in the background, keeping its room, while the time-out is
+    reported.
     """
     box: dict[str, object] = {}
     stopper = _Stopper()
@@ -273,7 +280,10 @@ def run_in_thread(function: Callable, args: tuple, limit: float) -> tuple[str, o
         while worker.is_alive() and time.monotonic() < deadline:
             stopper.mark(sys._current_frames().get(worker.ident))
             worker.join(_REPEAT)
-        stopper.take_room_back()
+            if worker.is_alive():  # the tick of run_with_alarm: a handler spinning untraced
+                _send(worker, TimeIsUp)
+        if not worker.is_alive():  # a worker left behind deep in a recursion keeps its room
+            stopper.take_room_back()
         outcome = box.get("outcome")
         return ("timeout", outcome[1] if isinstance(outcome, tuple) and outcome[0] != "returned"
                 else None)

@@ -417,3 +417,24 @@ def test_a_slow_function_with_a_bare_except_that_ends_in_time_returns() -> None:
     limit = sys.getrecursionlimit()
     assert call(slow_but_ends, 1, time_limit=0.6) > 1
     assert sys.getrecursionlimit() == limit
+
+
+@pytest.mark.timeout(30, method="thread")
+@pytest.mark.parametrize("name", ["nested_try_same_frame", "handlers_that_loop"])
+def test_off_the_main_thread_the_worker_is_stopped_not_left_behind(name: str) -> None:
+    """The worker is sent the time-out again every 50 ms, as the main thread's timer
+    repeats, so a handler spinning untraced ends too."""
+    function = _students()[name]
+    outcome: dict[str, object] = {}
+
+    def run() -> None:
+        try:
+            call(function, *ARGS, time_limit=LIMIT)
+        except TimedOut as error:
+            outcome["message"] = str(error)
+
+    thread = threading.Thread(target=run)
+    thread.start()
+    thread.join(10)
+    assert outcome["message"].startswith(f"{name} did not return within 0.3 s")
+    assert not [worker for worker in threading.enumerate() if worker.name == "student code"]
