@@ -112,6 +112,7 @@ bench: $(STAMP)
 	$(BIN)/python benchmarks/bench_filter.py
 	$(BIN)/python benchmarks/bench_widgets.py
 	$(BIN)/python benchmarks/bench_notebooks.py
+	$(BIN)/python benchmarks/bench_student_code.py
 
 # Key press on a slider -> new picture shown, in a real JupyterLab (needs Debian's chromium).
 bench-browser: $(STAMP)

@@ -186,11 +186,18 @@ def test_every_function_task_is_called_with_its_allowlist() -> None:
 #: The only pack functions a student's function may run: the wrappers around it.
 MACHINERY = {
     # running.py: the time limit's signal handler and the hooks that stop the function
+    "lqe_helpers.student_code.running.TimeIsUp.__del__",
     "lqe_helpers.student_code.running._Stopper.__init__",
     "lqe_helpers.student_code.running._Stopper.end",
+    "lqe_helpers.student_code.running._Stopper.error",
+    "lqe_helpers.student_code.running._Stopper.give_room",
+    "lqe_helpers.student_code.running._Stopper.in_hooks",
     "lqe_helpers.student_code.running._Stopper.mark",
     "lqe_helpers.student_code.running._Stopper.profile",
+    "lqe_helpers.student_code.running._Stopper.rearm",
+    "lqe_helpers.student_code.running._Stopper.retrace",
     "lqe_helpers.student_code.running._Stopper.stop",
+    "lqe_helpers.student_code.running._Stopper.take_room_back",
     "lqe_helpers.student_code.running._Stopper.trace",
     "lqe_helpers.student_code.running._Stopper.trace_stack",
     "lqe_helpers.student_code.running._send",
