@@ -55,7 +55,11 @@ MAX_JOURNAL_BYTES = 4 * 2**20
 #: The temporary folder of a swap: exactly this pattern, and stamped (:data:`_STAMP`).
 STAGING = re.compile(r"\.lqe-build-[0-9a-f]{16}")
 _STAMP = "made-by"
-#: Test hook: a tool run with this variable set to k kills itself (SIGKILL) at step k.
+#: Test hook: a tool run with this variable set to k kills itself (SIGKILL) at step k. The
+#: steps (:func:`_step`), in order: before the temporary folder is made, before it is stamped,
+#: before each staged file, before the journal, before each move aside and each link,
+#: before each part of the temporary folder is removed (its ``new``, its ``old``), before it
+#: is removed, before the journal is; an undo or a recovery counts its moves too.
 KILL_AT_STEP = "LQE_KILL_AT_STEP"
 _steps = [0]
 
@@ -279,9 +283,9 @@ def _write_journal(folder: Path, journal: Journal) -> None:
 def _finish(folder: Path, journal: Journal | None, staging: Path) -> None:
     """Remove the temporary folder (if stamped as ours), then the journal."""
     if _ours(staging):
-        _step()
         for entry in os.scandir(staging):  # the stamp last: a kill leaves it recognisable
             if entry.name != _STAMP:
+                _step()
                 shutil.rmtree(entry.path) if entry.is_dir(follow_symlinks=False) \
                     else os.unlink(entry.path)
         (staging / _STAMP).unlink(missing_ok=True)
@@ -345,6 +349,7 @@ def _stage(folder: Path, tool: str, writes: Mapping[str, bytes],
     staging = folder / journal.staging
     _step()
     staging.mkdir(mode=0o700)
+    _step()  # made, not yet stamped (an empty one is recognised as ours)
     write_new_file(staging / _STAMP, f"{tool}\n".encode())
     for name, data in writes.items():
         target = folder / name
