@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import re
 import subprocess
 import sys
@@ -282,3 +283,34 @@ def test_cause_of_a_check_names_its_task_cells_error() -> None:
     assert grade.cause(check, cell("# Task: ...")) == grade.cause(check) == \
         "NameError: name 'late_readings' is not defined"
     assert grade.cause(cell("checks.check_x()"), task) == grade.PASSED
+
+
+def test_grade_tool_starts_a_notebook_once_the_functions_it_loads_are_saved(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A student's 05 waits for their 01 (whose run saves my_filter); the others go on."""
+    started, finished = [], set()
+
+    class Child:  # a worker that ends at its first poll
+        def __init__(self, command: list[str], **_: object) -> None:
+            self.result = Path(command[command.index("--result") + 1])
+            loads = [Path(p) for flag, p in itertools.pairwise(command)
+                     if flag == "--functions-from"]
+            started.append((self.result.name, [p.name for p in loads],
+                            all(p in finished for p in loads)))
+            self.pid, self.returncode = 0, None
+
+        def poll(self) -> int:
+            self.returncode = 0
+            finished.add(self.result)
+            return 0
+
+        def communicate(self) -> tuple[bytes, bytes]:
+            return b"", b""
+
+    monkeypatch.setattr(grade.subprocess, "Popen", Child)
+    item = lambda name, loads=(): (tmp_path / name, WORKED, tmp_path / name, "",  # noqa: E731
+                                   [tmp_path / load for load in loads])
+    grade._run_workers([item("alice-01"), item("alice-05", ["alice-01"]), item("bob-01")],
+                       2, 60, 600)
+    assert started == [("alice-01", [], True), ("bob-01", [], True),
+                       ("alice-05", ["alice-01"], True)]
