@@ -1,4 +1,5 @@
-"""Simulated submissions of notebook 01, made from the worked notebook and its student edition.
+"""Simulated submissions of notebook 01 (and of 02–05 for the whole assignment), made from
+the worked notebooks and their student editions or nbgrader's release.
 
 Used by the grading tests (tests/authoring/test_grading*.py) and benchmarks/bench_grading.py. Each
 maker returns the text of an ``.ipynb`` file (or raw bytes for the broken ones).
@@ -57,11 +58,13 @@ def _tasks(notebook: nbformat.NotebookNode) -> list[nbformat.NotebookNode]:
             if {SOLUTION_TAG, TASK_TAG} & set(cell_tags(cell))]
 
 
-def _filled(notebook: nbformat.NotebookNode,
-            bodies: list[str | None]) -> nbformat.NotebookNode:
-    """``notebook`` (a student's copy) with each core task's code (None: the worked one)."""
+def _filled(notebook: nbformat.NotebookNode, bodies: list[str | None],
+            source: Path = WORKED) -> nbformat.NotebookNode:
+    """``notebook`` (a student's copy of the worked notebook ``source``) with each core
+    task's code (None: the worked one)."""
     notebook = copy.deepcopy(notebook)
-    for task, solution, body in zip(_tasks(notebook), _tasks(worked()), bodies, strict=True):
+    solutions = _tasks(nbformat.read(source, as_version=4))
+    for task, solution, body in zip(_tasks(notebook), solutions, bodies, strict=True):
         task.source = solution.source if body is None else \
             "# Task: (the student's)\n" + body
     return notebook
@@ -70,6 +73,13 @@ def _filled(notebook: nbformat.NotebookNode,
 def filled(notebook: nbformat.NotebookNode) -> nbformat.NotebookNode:
     """Every task written as the worked notebook does."""
     return _filled(notebook, [None, None])
+
+
+def filled_as(notebook: nbformat.NotebookNode, name: str) -> nbformat.NotebookNode:
+    """A student's copy of the worked notebook ``name`` (e.g. ``03_fusion.ipynb``) with
+    every core task written as the worked notebook does."""
+    source = WORKED.parent / name
+    return _filled(notebook, [None] * len(_tasks(notebook)), source)
 
 
 def wrong_science(notebook: nbformat.NotebookNode) -> nbformat.NotebookNode:

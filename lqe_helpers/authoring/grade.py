@@ -3,11 +3,13 @@
 ``python -m lqe_helpers.authoring.grade SUBMISSIONS_DIR --out build/grades [--source notebooks]``
 
 ``SUBMISSIONS_DIR`` holds one folder per student with the notebooks they submitted (named
-as the course's, e.g. ``alice/01_vision_only.ipynb``; a student's ``my_functions/`` is used
-by notebooks 02–05). Each notebook is graded in its own process on a fresh kernel, top to
-bottom, its saved outputs and execution order ignored, ``--jobs`` at a time (default: every
-core), within ``--cell-timeout`` seconds per cell (a cell past it is interrupted and the run
-goes on) and ``--notebook-timeout`` per notebook (then it is stopped and its checks get 0).
+as the course's, e.g. ``alice/01_vision_only.ipynb``). Each notebook is graded in its own
+process on a fresh kernel, top to bottom, its saved outputs and execution order ignored,
+``--jobs`` at a time (default: every core), within ``--cell-timeout`` seconds per cell (a cell
+past it is interrupted and the run goes on) and ``--notebook-timeout`` per notebook (then it
+is stopped and its checks get 0). As under nbgrader, a notebook loads the functions that the
+grading runs of the student's earlier notebooks saved (02–05 the ``my_filter`` of their own
+01, once it is graded); a submitted ``my_functions/`` is not used.
 Only the core path is run (up to ``## Going further``); explorer cells are left out (they
 only draw), and every cell of the worked notebook other than a task (check cells included)
 is restored from ``--source``, so an edited check cannot pass. A check earns its points
@@ -15,7 +17,8 @@ is restored from ``--source``, so an edited check cannot pass. A check earns its
 
 Writes, only under ``--out``: ``results/<student>/<notebook>.json`` (one per submission, as
 soon as it is graded, atomically; a rerun skips those whose submission is unchanged, so a
-killed run resumes), then ``grades.csv`` (student, notebook, question, automatic points, out
+killed run resumes; a notebook is graded again when a notebook whose saved functions it
+loads changed), then ``grades.csv`` (student, notebook, question, automatic points, out
 of, and per check ``passed`` or its one-line cause) and ``feedback/<student>.html``. Every
 submission gets a row, whatever it holds (not a notebook, invalid JSON, empty, too large).
 """
@@ -47,10 +50,22 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.errors import error_line, first_line, shown, strip_colour
     from lqe_helpers.authoring.execution import positive_seconds
     from lqe_helpers.authoring.files import atomic_write_text
-    from lqe_helpers.authoring.grading import QUESTION_LABELS, core_end, graded_cells
+    from lqe_helpers.authoring.grading import (
+        QUESTION_LABELS,
+        SAVED_FUNCTIONS,
+        core_end,
+        graded_cells,
+        saves_functions,
+    )
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
-    from lqe_helpers.authoring.task_cells import EXPLORER_TAG, SOLUTION_TAG, TASK_TAG, cell_tags
+    from lqe_helpers.authoring.task_cells import (
+        EXPLORER_TAG,
+        SOLUTION_TAG,
+        TASK_PREFIX,
+        TASK_TAG,
+        cell_tags,
+    )
 
 CELL_TIMEOUT, NOTEBOOK_TIMEOUT = 60.0, 600.0
 PASSED = "passed"
@@ -95,20 +110,28 @@ def graded_copy(submission: nbformat.NotebookNode, worked: nbformat.NotebookNode
     return run, set(checks.values()) - found
 
 
-def cause(cell: nbformat.NotebookNode) -> str:
-    """``passed``, or the one-line cause of the first error a cell's outputs hold."""
+def cause(cell: nbformat.NotebookNode, task: nbformat.NotebookNode | None = None) -> str:
+    """``passed``, or the one-line cause of the first error a cell's outputs hold; for a
+    check cell whose ``task`` cell stopped with an error too, that error is named after it
+    (a ``NameError`` of the check then says why the name was never made)."""
     for output in cell.get("outputs", []):
         if output.output_type == "error":
             line = first_line(strip_colour(f"{output.ename}: {output.evalue}"))
-            return line.replace("\n", " ").strip()
+            line = line.replace("\n", " ").strip()
+            before = PASSED if task is None else cause(task)
+            return line if before == PASSED else f"{line} (its task cell stopped: {before})"
     return PASSED
 
 
-def grade_one(path: Path, worked_path: Path, cell_timeout: float, result_path: Path) -> dict:
+def grade_one(path: Path, worked_path: Path, cell_timeout: float, result_path: Path,
+              functions_from: Sequence[Path] = ()) -> dict:
     """Run one submission in a fresh kernel; return its result (see the module docstring).
 
     The kernel runs in a temporary folder beside ``result_path``, which also gets the
-    kernel's process id while it runs (:func:`_side_files`), for :func:`_stop`."""
+    kernel's process id while it runs (:func:`_side_files`), for :func:`_stop`, and the
+    functions saved by the grading runs whose results are ``functions_from`` (in order; a
+    later one replaces an earlier), in :data:`SAVED_FUNCTIONS`. The result of a notebook
+    that saves functions holds, under ``"saved"``, that folder's files after its run."""
     from nbclient import NotebookClient
 
     worked = read_notebook(worked_path)
@@ -123,9 +146,9 @@ def grade_one(path: Path, worked_path: Path, cell_timeout: float, result_path: P
     result["checks"].update(dict.fromkeys(missing, "check cell missing from the submission"))
     pid_file, work_prefix = _side_files(result_path)
     with tempfile.TemporaryDirectory(dir=result_path.parent, prefix=work_prefix) as work:
-        if (path.parent / "my_functions").is_dir():
-            shutil.copytree(path.parent / "my_functions", Path(work) / "my_functions",
-                            symlinks=False, ignore_dangling_symlinks=True)
+        saved = Path(work) / SAVED_FUNCTIONS
+        for provider in functions_from:
+            _write_saved(saved, _saved_functions(provider))
         client = NotebookClient(run, timeout=cell_timeout, allow_errors=True,
                                 interrupt_on_timeout=True, store_widget_state=False,
                                 error_on_timeout={"ename": "TimeoutError", "evalue":
@@ -140,13 +163,36 @@ def grade_one(path: Path, worked_path: Path, cell_timeout: float, result_path: P
             result["error"] = error_line(error)
         finally:
             pid_file.unlink(missing_ok=True)
+        if saves_functions(worked) and saved.is_dir():
+            result["saved"] = {file.name: file.read_text(encoding="utf-8", errors="replace")
+                               for file in sorted(saved.glob("*.py")) if file.is_file()}
+    task = None  # the latest task cell run (a check judges what it made)
     for cell in run.cells:
+        task = cell if cell.source.lstrip().startswith(TASK_PREFIX) else task
         grade_id = next((gid for gid in points if f"checks.{gid}(" in cell.source), None)
         if grade_id and cell.get("execution_count") is not None:
-            result["checks"][grade_id] = cause(cell)
+            result["checks"][grade_id] = cause(cell, task)
     result["points"] = sum(points[g] for g, outcome in result["checks"].items()
                            if outcome == PASSED)
     return result
+
+
+def _saved_functions(result_path: Path) -> dict[str, str]:
+    """The functions a saved result says its run left in :data:`SAVED_FUNCTIONS` (none if
+    it has no usable result)."""
+    try:
+        saved = json.loads(result_path.read_text(encoding="utf-8")).get("saved", {})
+    except (OSError, ValueError, AttributeError):
+        return {}
+    return saved if isinstance(saved, dict) else {}
+
+
+def _write_saved(folder: Path, saved: dict[str, str]) -> None:
+    """Write ``saved`` (file name: text) into ``folder``; only plain ``*.py`` names."""
+    for name, text in saved.items():
+        if isinstance(text, str) and Path(name).name == name and name.endswith(".py"):
+            folder.mkdir(exist_ok=True)
+            atomic_write_text(folder / name, text)
 
 
 def submissions(folder: Path, source_dir: Path) -> list[tuple[str, str, Path | None, Path | None]]:
@@ -179,9 +225,20 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
         raise ValueError(f"--out must not lie inside SUBMISSIONS_DIR, got {shown(out)}")
     out.mkdir(parents=True, exist_ok=True)
     rows, todo, skipped = [], [], 0
+    saves: dict[Path, bool] = {}  # worked notebook: whether it saves functions for later ones
+    providers: dict[str, list[tuple[Path, str]]] = {}  # student: (result, digest) of those
     for student, name, path, worked in submissions(folder, source_dir):
         result_path = out / "results" / student / f"{name or 'no-notebook'}.json"
         digest = _digest(path) if path and path.is_file() else ""
+        earlier = list(providers.setdefault(student, []))
+        if digest and earlier:  # graded again when a notebook it loads functions from changed
+            digest = hashlib.sha256(" ".join([digest, *(d for _, d in earlier)]).encode()
+                                    ).hexdigest()
+        if worked is not None and digest:
+            if worked not in saves:
+                saves[worked] = saves_functions(read_notebook(worked))
+            if saves[worked]:
+                providers[student].append((result_path, digest))
         rows.append((student, name, result_path, worked))
         if _saved_digest(result_path) == digest:
             skipped += 1
@@ -194,7 +251,7 @@ def grade_all(folder: Path, out: Path, source_dir: Path, *, jobs: int,
             _save(result_path, {"checks": {}, "points": 0.0, "out_of": 0.0, "sha256": digest,
                                 "error": f"not graded: {why}"})
             continue
-        todo.append((path, worked, result_path, digest))
+        todo.append((path, worked, result_path, digest, [result for result, _ in earlier]))
     graded = len(todo)
     _run_workers(todo, jobs, cell_timeout, notebook_timeout)
     return _write_reports(rows, out), graded, skipped
@@ -223,19 +280,27 @@ def _save(path: Path, result: dict) -> None:
 
 
 def _run_workers(todo: list, jobs: int, cell_timeout: float, notebook_timeout: float) -> None:
-    """Grade each submission in a child process, ``jobs`` at a time, each within its limit."""
+    """Grade each submission in a child process, ``jobs`` at a time, each within its limit;
+    one whose functions come from other submissions' results starts once they are saved."""
     running: dict[subprocess.Popen, tuple] = {}
     try:
         while todo or running:
-            while todo and len(running) < jobs:
-                path, worked, result_path, digest = item = todo.pop(0)
+            while len(running) < jobs:
+                pending = {item[2] for item in [*todo, *running.values()]}
+                item = next((item for item in todo if not pending & set(item[4])), None)
+                if item is None:
+                    break
+                todo.remove(item)
+                path, worked, result_path, digest, functions_from = item
                 _remove_side_files(result_path)
                 command = [sys.executable, "-m", "lqe_helpers.authoring.grade", "--one",
                            str(path), "--worked", str(worked), "--result", str(result_path),
-                           "--sha256", digest, "--cell-timeout", str(cell_timeout)]
+                           "--sha256", digest, "--cell-timeout", str(cell_timeout),
+                           *(arg for result in functions_from
+                             for arg in ("--functions-from", str(result)))]
                 child = subprocess.Popen(command, stdout=subprocess.DEVNULL,
                                          stderr=subprocess.PIPE, start_new_session=True)
-                running[child] = (*item, time.monotonic())
+                running[child] = (path, worked, result_path, digest, time.monotonic())
             time.sleep(0.1)
             for child, (_, worked, result_path, digest, start) in list(running.items()):
                 late = time.monotonic() - start > notebook_timeout
@@ -344,13 +409,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--notebook-timeout", type=positive_seconds, default=NOTEBOOK_TIMEOUT)
     for hidden in ("--one", "--worked", "--result", "--sha256"):  # a worker's own options
         parser.add_argument(hidden, help=argparse.SUPPRESS)
+    parser.add_argument("--functions-from", action="append", default=[], help=argparse.SUPPRESS)
 
     def command(args: argparse.Namespace) -> int:
         if args.one:
             result_path = Path(args.result)
             result_path.parent.mkdir(parents=True, exist_ok=True)
             result = grade_one(Path(args.one), Path(args.worked), args.cell_timeout,
-                               result_path)
+                               result_path, [Path(p) for p in args.functions_from])
             _save(Path(args.result), {**result, "sha256": args.sha256})
             return 0
         if args.submissions is None:

@@ -32,6 +32,12 @@ ANSWER_SHARE = Fraction(2, 5)
 CHECK_NAME = re.compile(r"\bchecks\.(check_\w+)\s*\(")
 #: The tutorial's question of each graded notebook, by its number.
 QUESTION_LABELS = {"01": "(a)", "02": "(b)", "03": "(c)", "04": "(d)", "05": "(e)"}
+#: The folder where a check saves a student's function for later notebooks
+#: (``student_code.SAVE_FOLDER``: 01 saves ``my_filter``, which 02–05 load). Grading makes it
+#: anew from the submission's own notebooks; a submitted or instructor's copy is never used.
+SAVED_FUNCTIONS = "my_functions"
+#: The call by which a notebook saves a student's function for later notebooks.
+SAVE_CALL = "student_code.save("
 
 
 def question_label(notebook_name: str) -> str:
@@ -67,6 +73,13 @@ def core_end(notebook: nbformat.NotebookNode) -> int:
     return next((index for index, cell in enumerate(notebook.cells)
                  if cell.cell_type == "markdown"
                  and cell.source.lstrip().startswith(GOING_FURTHER)), len(notebook.cells))
+
+
+def saves_functions(notebook: nbformat.NotebookNode) -> bool:
+    """Whether a worked notebook's core path saves a student's function (into
+    :data:`SAVED_FUNCTIONS`) for the notebooks after it."""
+    return any(cell.cell_type == "code" and SAVE_CALL in cell.source
+               for cell in notebook.cells[:core_end(notebook)])
 
 
 def is_check_cell(cell: nbformat.NotebookNode | None) -> bool:

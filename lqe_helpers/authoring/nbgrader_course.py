@@ -36,7 +36,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
     from lqe_helpers.authoring.files import atomic_write_text
-    from lqe_helpers.authoring.grading import core_end, graded_cells
+    from lqe_helpers.authoring.grading import SAVED_FUNCTIONS, core_end, graded_cells
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import notebook_bytes, read_notebook, source_notebooks
     from lqe_helpers.authoring.task_cells import (
@@ -86,6 +86,12 @@ c.Execute.timeout = {CELL_TIMEOUT}
 c.Execute.interrupt_on_timeout = True
 c.Execute.allow_errors = True
 # A check cell a student edited is restored from source/ (nbgrader's OverwriteCells).
+# {SAVED_FUNCTIONS}/ is made by each run of 01 (my_filter) and 05 (compensate): ignored, so
+# the worked my_filter that running source/{ASSIGNMENT}/ writes there is never released nor
+# copied over a submission, and a submitted copy is not used: autograde runs the notebooks
+# in order in one folder, so 02-05 load the my_filter the submission's own 01 saves.
+c.CourseDirectory.ignore = [".ipynb_checkpoints", "*.pyc", "__pycache__", "feedback",
+                            "{SAVED_FUNCTIONS}"]
 '''
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import re
 import subprocess
 import sys
@@ -241,3 +242,75 @@ def test_grade_tool_gives_a_huge_submission_its_row(tmp_path: Path) -> None:
 def test_question_labels() -> None:
     assert [grading.question_label(p.name) for p in NOTEBOOKS] == [
         NOTEBOOKS[0].name, "(a)", "(b)", "(c)", "(d)", "(e)", NOTEBOOKS[-1].name]
+
+
+def test_nbgrader_config_ignores_saved_functions() -> None:
+    """my_functions/ never goes from source/ to release/ or a graded copy, nor from a
+    submission: nbgrader's defaults plus it (the folder student_code saves into)."""
+    from traitlets.config import Config
+
+    from lqe_helpers import student_code
+
+    config = Config()
+    exec(nbgrader_course.CONFIG, {"get_config": lambda: config})  # as nbgrader loads it
+    assert grading.SAVED_FUNCTIONS == student_code.SAVE_FOLDER
+    assert config.CourseDirectory.ignore == [".ipynb_checkpoints", "*.pyc", "__pycache__",
+                                             "feedback", grading.SAVED_FUNCTIONS]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
+def test_saves_functions_finds_the_notebooks_that_save(path: Path) -> None:
+    """01 saves my_filter and 05 compensate, for the later notebooks (and their explorers)."""
+    saves = grading.saves_functions(nbformat.read(path, as_version=4))
+    assert saves == (path.name[:2] in {"01", "05"})
+
+
+def test_cause_of_a_check_names_its_task_cells_error() -> None:
+    """A check that fails because its task cell stopped says why the task stopped."""
+    def cell(source: str, ename: str | None = None, evalue: str = "") -> nbformat.NotebookNode:
+        code = nbformat.v4.new_code_cell(source)
+        if ename:
+            code.outputs = [nbformat.v4.new_output("error", ename=ename, evalue=evalue,
+                                                   traceback=[])]
+        return code
+
+    check = cell("checks.check_delay_signals(late_readings)", "NameError",
+                 "name 'late_readings' is not defined")
+    task = cell("# Task: ...", "NotSavedYet", "my_filter is not saved yet: notebook 01 …")
+    assert grade.cause(check, task) == (
+        "NameError: name 'late_readings' is not defined (its task cell stopped: "
+        "NotSavedYet: my_filter is not saved yet: notebook 01 …)")
+    assert grade.cause(check, cell("# Task: ...")) == grade.cause(check) == \
+        "NameError: name 'late_readings' is not defined"
+    assert grade.cause(cell("checks.check_x()"), task) == grade.PASSED
+
+
+def test_grade_tool_starts_a_notebook_once_the_functions_it_loads_are_saved(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A student's 05 waits for their 01 (whose run saves my_filter); the others go on."""
+    started, finished = [], set()
+
+    class Child:  # a worker that ends at its first poll
+        def __init__(self, command: list[str], **_: object) -> None:
+            self.result = Path(command[command.index("--result") + 1])
+            loads = [Path(p) for flag, p in itertools.pairwise(command)
+                     if flag == "--functions-from"]
+            started.append((self.result.name, [p.name for p in loads],
+                            all(p in finished for p in loads)))
+            self.pid, self.returncode = 0, None
+
+        def poll(self) -> int:
+            self.returncode = 0
+            finished.add(self.result)
+            return 0
+
+        def communicate(self) -> tuple[bytes, bytes]:
+            return b"", b""
+
+    monkeypatch.setattr(grade.subprocess, "Popen", Child)
+    item = lambda name, loads=(): (tmp_path / name, WORKED, tmp_path / name, "",  # noqa: E731
+                                   [tmp_path / load for load in loads])
+    grade._run_workers([item("alice-01"), item("alice-05", ["alice-01"]), item("bob-01")],
+                       2, 60, 600)
+    assert started == [("alice-01", [], True), ("bob-01", [], True),
+                       ("alice-05", ["alice-01"], True)]
