@@ -331,8 +331,9 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
         judge(label, estimates, right["estimates"], FUNCTION_RTOL,
               mistakes=right["estimate_mistakes"],
               what="the pack's engine on these readings with R = [[σ_v²]]",
-              hint="my_filter passed its check, so look at what vision_trial gives it: y, "
-                   "A, C = [[1, 0, 0]], Q, R = [[σ_v²]], z0 and P0")
+              hint="if my_filter passed its check (Task 1), look at what vision_trial gives "
+                   "it: y, A, C = [[1, 0, 0]], Q, R = [[σ_v²]], z0 and P0; if not, make it "
+                   "pass first")
         problem = not_driven(estimates, filtered, "my_filter", f"{name}({sigma:g})")
         if problem is not None:
             raise CheckFailed(problem)

@@ -406,3 +406,21 @@ def test_check_vision_needs_no_student_function_and_leaves_the_engine_alone() ->
     y = simulation.measure(TRUTH, noise, [4.5])
     assert np.array_equal(y, TRUTH[:, None] + 4.5 * NOISE)
     assert model.observation_matrix(("vision",)).tolist() == C_VISION.tolist()
+
+
+def test_vision_trial_with_a_wrong_my_filter_is_not_told_my_filter_passed() -> None:
+    """helper review: the hint said "my_filter passed its check" to a student whose
+    my_filter (Q left out) had not; it now says what to do in both cases."""
+    def forgetful_filter(y, A, C, Q, R, z0, P0):
+        return student_filter(y, A, C, np.zeros_like(Q), R, z0, P0)
+
+    namespace = {"my_filter": forgetful_filter, "np": np, "TRUTH": TRUTH, "NOISE": NOISE,
+                 "A": A_SET, "C": C_VISION, "Q": Q_SET, "P0": P0_SET}
+    exec("def vision_trial(sigma_v):\n"  # a notebook's namespace, as a kernel has
+         "    y = TRUTH[:, None] + sigma_v * NOISE\n"
+         "    return y, my_filter(y, A, C, Q, np.array([[sigma_v**2]]), np.zeros(3), P0)\n",
+         namespace)
+    with pytest.raises(CheckFailed) as failure:
+        checks.check_vision_trial(namespace["vision_trial"])
+    assert "if my_filter passed its check (Task 1)" in str(failure.value)
+    assert "if not, make it pass first" in str(failure.value)
