@@ -209,8 +209,10 @@ def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
     names = ", ".join(drawn) or "a value"
     return (f"the task cell above uses {names} from a cell you ran before it "
             f"(`{found.cell.first_line[:60]}`), and that cell runs {runs}: a value the pack "
-            f"computed there and copied is not your own work. Make the values in the task cell "
-            f"with your own code, run it, then this check again")
+            f"computed there and copied is not your own work. If that cell is one of yours, "
+            f"make the values in the task cell with your own code; if it is a cell of the "
+            f"notebook whose code you changed, put its code back as it was and run it again. "
+            f"Then run the task cell and this check")
 
 
 def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray]:
@@ -259,6 +261,16 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
     used = forbidden_calls(check, run)
     if used:
         return forbidden_text(used[0], run)
+    if check in TOP_LEVEL:
+        for cell in task_runs.ancestry(run):
+            if cell.other_process:
+                where = ("the task cell above" if cell.number == run.number else
+                         f"a cell you ran before the task cell (`{cell.first_line[:60]}`), "
+                         f"whose values it uses,")
+                return (f"{where} runs another program (a subprocess, os.system, "
+                        f"multiprocessing): the check cannot see what it computes, so it "
+                        f"cannot tell its values from the pack's. Compute them in the notebook "
+                        f"itself, run that cell, then this check again")
     for wanted in DRIVEN.get(check, ()):
         if wanted.position >= len(args):
             continue

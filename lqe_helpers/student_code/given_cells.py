@@ -15,14 +15,24 @@ through the cells the student wrote, and only those.
 
 from __future__ import annotations
 
+import ast
 import hashlib
 
 from ._given_cell_keys import GIVEN
 
 
 def cell_key(source: str) -> str:
-    """16 hex digits of the SHA-256 of a cell's code (line ends and outer blanks normalised)."""
+    """16 hex digits of the SHA-256 of a cell's code, as Python reads it.
+
+    The key is of the code's syntax tree, so comments, blank lines and spacing do not
+    change it (a student's note in a given cell leaves it given); code that does not
+    parse is keyed by its text (line ends and outer blanks normalised).
+    """
     text = source.replace("\r\n", "\n").replace("\r", "\n").strip()
+    try:
+        text = ast.dump(ast.parse(text))
+    except (SyntaxError, ValueError):
+        pass
     return hashlib.sha256(text.encode("utf-8", "surrogatepass")).hexdigest()[:16]
 
 

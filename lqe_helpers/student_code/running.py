@@ -187,6 +187,21 @@ class _Stopper:
         sys.setprofile(previous_profile)
 
 
+def _unraisable(stopper: _Stopper, previous: Callable) -> Callable:
+    """A ``sys.unraisablehook`` that drops what stopping the call leaves unraisable: a
+    :class:`TimeIsUp` raised while Python closed an abandoned generator of the student's
+    (or the generator's "ignored GeneratorExit" once time is up); anything else goes on."""
+
+    def hook(unraisable: object) -> None:
+        kind = getattr(unraisable, "exc_type", None)
+        if kind is TimeIsUp or (stopper.stopping and kind is RuntimeError and "GeneratorExit"
+                                in str(getattr(unraisable, "exc_value", ""))):
+            return
+        previous(unraisable)
+
+    return hook
+
+
 def run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str, object]:
     """``function(*args)`` stopped after ``limit`` s by SIGALRM (main thread only).
 
@@ -214,6 +229,7 @@ def run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str, 
     previous = signal.signal(signal.SIGALRM, on_alarm)
     outer_delay, outer_interval = signal.setitimer(signal.ITIMER_REAL, limit, _REPEAT)
     start = time.monotonic()
+    unraisable, sys.unraisablehook = sys.unraisablehook, _unraisable(stopper, sys.unraisablehook)
     try:
         outcome: tuple[str, object] = ("returned", function(*args))
     except TimeIsUp as error:
@@ -224,6 +240,7 @@ def run_with_alarm(function: Callable, args: tuple, limit: float) -> tuple[str, 
         state["armed"] = False
         stopper.end(*hooks)
         stopper.take_room_back()
+        sys.unraisablehook = unraisable
     signal.setitimer(signal.ITIMER_REAL, 0)
     signal.signal(signal.SIGALRM, signal.SIG_DFL if previous is None else previous)
     if outer_delay:  # an outer timer (e.g. pytest-timeout's) runs on, a little late

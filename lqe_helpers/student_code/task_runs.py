@@ -27,6 +27,8 @@ checks then behave as without it.
 from __future__ import annotations
 
 import dataclasses
+import functools
+import os
 import sys
 import types
 from collections.abc import Callable
@@ -99,6 +101,9 @@ class TaskRun:
         In a cell of the student's (not given): the small numeric results (numbers and
         arrays of at most :data:`RESULT_SIZE` numbers, copied) of the pack's functions it
         ran, each with the function's name, at most :data:`RESULTS_KEPT`.
+    other_process : bool
+        Whether it ran another program (``subprocess``, ``os.system``, ``multiprocessing``,
+        a fork), whose work the record cannot see.
     saved_calls : list of SavedCall
         Its calls of the student's loaded functions.
     """
@@ -115,6 +120,7 @@ class TaskRun:
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
     entries: dict[str, str] = field(default_factory=dict)
     results: list[tuple[str, np.ndarray]] = field(default_factory=list)
+    other_process: bool = False
     saved_calls: list[SavedCall] = field(default_factory=list)
 
     @property
@@ -159,12 +165,16 @@ class _Record:
                 name = pack_calls.get(code)
                 if name is None:
                     if not in_pack(code.co_filename):
+                        if _starts_a_process(code.co_filename):
+                            run.other_process = True
                         return
                     name = pack_calls[code] = pack_name(frame)
                 if not entry[1]:
                     entry[0] = name
                 entry[1] += 1
                 entries.setdefault(name, entry[0])
+            elif event == "c_call" and arg in _PROCESS_CALLS:
+                run.other_process = True
             elif event == "return" and frame.f_code in pack_calls:
                 entry[1] = max(entry[1] - 1, 0)
                 if keep_results and len(results) < RESULTS_KEPT:
@@ -236,14 +246,34 @@ def run_for(check: str) -> TaskRun | None:
             now, completed=True, saved_calls=list(now.saved_calls),
             pack_calls={code: name for code, name in list(now.pack_calls.items())
                         if not name.startswith(__name__)})
-    for run in reversed(_RECORD.runs):
+    for index in range(len(_RECORD.runs) - 1, -1, -1):
+        run = _RECORD.runs[index]
         if names & run.defines or (run.task and run.not_written and names & run.mentions):
-            return run
+            # a later try at the same task (the same ``# Task:`` comment) that stopped
+            # before making them is the attempt to judge, not this older run
+            failed = [later for later in _RECORD.runs[index + 1:] if run.task and later.task
+                      and later.mentions == run.mentions and not later.completed]
+            return failed[-1] if failed else run
     for run in reversed(_RECORD.runs):
         if run.task and names & run.mentions:
             return run
     tasks = [run for run in _RECORD.runs if run.task]
     return tasks[-1] if tasks else None
+
+
+#: The C functions that start or become another program (os.system, fork, exec, spawn).
+_PROCESS_CALLS = frozenset(getattr(os, name) for name in (
+    "system", "fork", "forkpty", "execv", "execve", "execvp", "execvpe", "execl", "execle",
+    "execlp", "execlpe", "posix_spawn", "posix_spawnp", "spawnv", "spawnve")
+    if hasattr(os, name))
+
+
+@functools.lru_cache(maxsize=4096)
+def _starts_a_process(filename: str) -> bool:
+    """Whether code of ``filename`` is the standard library's way to run another process."""
+    parts = filename.replace(os.sep, "/").split("/")
+    return parts[-1] in {"subprocess.py", "pty.py"} or "multiprocessing" in parts or (
+        "concurrent" in parts and parts[-1] == "process.py")
 
 
 def _small_result(value: object) -> np.ndarray | None:

@@ -203,6 +203,7 @@ MACHINERY = {
     "lqe_helpers.student_code.running._send",
     "lqe_helpers.student_code.running.run_in_thread",
     "lqe_helpers.student_code.running.run_with_alarm",
+    "lqe_helpers.student_code.running._unraisable",
     # calling.py: what guards.py asks while it reports a loaded function's error
     "lqe_helpers.student_code.calling.inside_call",
     "lqe_helpers.student_code.calling.reported",

@@ -736,3 +736,56 @@ def test_no_value_the_notebook_gives_holds_a_tasks_answer(notebook, answers, fol
             assert not holders, (answer, holders)
     finally:
         runner.close()
+
+
+@pytest.mark.slow
+def test_the_packs_answer_computed_in_another_python_process_fails(folder):
+    """The third trial (L-A): 03 Task 1's C and R from the pack run by a subprocess passed:
+    the record cannot see another process, so a task whose values depend on one is refused."""
+    code = ("import subprocess, sys, json\n"
+            "_o = json.loads(subprocess.check_output([sys.executable, '-c', 'from lqe_helpers "
+            "import model; import json; print(json.dumps([model.observation_matrix((\"vision\", "
+            "\"proprioception\")).tolist(), model.measurement_noise_covariance([1.5, 1.5])"
+            ".tolist()]))'], text=True))\n"
+            "C, R = np.array(_o[0]), np.array(_o[1])\n")
+    error, printed = run_task("03_fusion", "check_fusion", code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, printed = run_task("03_fusion", "check_fusion", code)
+    assert isinstance(error, CheckFailed), error
+    assert "the task cell above runs another program" in str(error), str(error)
+    error, printed = run_task("03_fusion", "check_fusion",
+                              "C, R = np.array(_o[0]), np.array(_o[1])\n",
+                              earlier=(code.rsplit("C, R", 1)[0],))
+    assert isinstance(error, CheckFailed), error
+    assert "a cell you ran before the task cell" in str(error), str(error)
+
+
+@pytest.mark.slow
+def test_a_task_cell_rerun_that_stops_before_making_its_values_is_judged_not_the_old_run(
+        folder):
+    """The third trial (L-B): after a right run, the task cell re-run with only a raise under
+    its comment defines nothing, and the check judged the earlier run's values."""
+    _before, task, _check = cells_up_to("02_initial_covariance", "check_start_of_trial")
+    error, printed = run_task("02_initial_covariance", "check_start_of_trial", None,
+                              before_check=task_comment(task) + "raise RuntimeError('oops')\n")
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "the task cell above stopped with an error" in str(error)
+
+
+@pytest.mark.slow
+def test_a_note_added_to_a_given_cell_leaves_it_the_notebooks(folder, monkeypatch):
+    """The third trial (D-1): a comment added to 02's given cell 6 (it runs the pack) made
+    the worked Task 1 fail, "copied is not your own work"."""
+    import cell_runner
+
+    original = cell_runner.code_cells
+
+    def noted(notebook):
+        return [(source + "  # my note" if "burn_in" in source and "solution" not in tags
+                 else source, tags) for source, tags in original(notebook)]
+
+    monkeypatch.setattr(cell_runner, "code_cells", noted)
+    before, _task, _check = cells_up_to("02_initial_covariance", "check_start_of_trial")
+    assert any(source.endswith("# my note") for source in before)
+    error, printed = run_task("02_initial_covariance", "check_start_of_trial", None)
+    assert error is None and printed.startswith("✓ "), (error, printed)

@@ -37,6 +37,8 @@ def test_a_changed_cell_is_the_students_and_line_ends_do_not_matter() -> None:
     source = cells[0]
     assert given_cells.is_given(source)
     assert given_cells.is_given(source.replace("\n", "\r\n") + "\n\n")
+    assert given_cells.is_given(source + "\n# a note of mine\n")  # the trial: a comment
+    assert given_cells.is_given("# mine\n" + source.replace("\n", "  # x\n", 1))
     assert not given_cells.is_given(source + "\nprint(1)")
     assert not given_cells.is_given("")
 
