@@ -24,7 +24,8 @@ Two kinds of task, two guards:
 
 :func:`judged` wraps every exported check (``checks/__init__.py``): before the check judges
 anything it finds the check's task cell (:func:`~lqe_helpers.student_code.task_runs.run_for`)
-and refuses when that cell's latest run stopped with an error, ran a forbidden function, or
+and refuses when that cell's latest run stopped with an error, ran a forbidden function,
+took numbers from outside the notebook (a file, another program: :func:`trail_problem`), or
 did not produce the values with the student's function. Without the record (plain Python,
 pytest, or before the set-up cell) a check behaves as without this module.
 """
@@ -189,10 +190,17 @@ def _short(name: str) -> str:
     return name.removeprefix("lqe_helpers.")
 
 
+def _public(name: str) -> str:
+    """A pack function's name as a notebook writes it, without what is defined inside it:
+    ``model.transition_matrix`` for ``lqe_helpers.model.transition_matrix.<locals>.<lambda>``."""
+    return _short(name).split(".<locals>", 1)[0]
+
+
 def _runs(entry: str, name: str) -> str:
     """"the pack's own X", or "the pack's X, which runs its own Y" for an inner function."""
-    return (f"the pack's own {_short(entry)}" if entry == name else
-            f"the pack's {_short(entry)}, which runs its own {_short(name)}")
+    entry, name = _public(entry), _public(name)
+    return (f"the pack's own {entry}" if entry == name else
+            f"the pack's {entry}, which runs its own {name}")
 
 
 def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
@@ -213,6 +221,30 @@ def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
             f"make the values in the task cell with your own code; if it is a cell of the "
             f"notebook whose code you changed, put its code back as it was and run it again. "
             f"Then run the task cell and this check")
+
+
+def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
+    """Why the values of the task run ``run`` or of a cell of the student's they draw on
+    (:func:`~lqe_helpers.student_code.task_runs.ancestry`) may be the pack's, or None: a
+    function of ``check``'s forbidden set ran there (:func:`forbidden_calls`), or the cell
+    took something from outside the notebook (a file it read, another program it ran:
+    :attr:`~lqe_helpers.student_code.task_runs.TaskRun.outside`), whose numbers the record
+    cannot trace."""
+    used = forbidden_calls(check, run)
+    if used:
+        return forbidden_text(used[0], run)
+    if check not in TOP_LEVEL:
+        return None
+    for cell in task_runs.ancestry(run):
+        if cell.outside:
+            where = ("the task cell above" if cell.number == run.number else
+                     f"a cell you ran before the task cell (`{cell.first_line[:60]}`), whose "
+                     f"values it uses,")
+            return (f"{where} {cell.outside[0]}: the check cannot see how numbers from a "
+                    f"file or another program were made, so it cannot tell them from the "
+                    f"pack's answer. Compute them in the notebook itself, with your own code, "
+                    f"run that cell, then this check again")
+    return None
 
 
 def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray]:
@@ -258,19 +290,9 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
     if not run.completed:
         return (f"the task cell above stopped with an error: {RERUN} (it judges what that "
                 f"cell makes, not the values of an earlier run)")
-    used = forbidden_calls(check, run)
-    if used:
-        return forbidden_text(used[0], run)
-    if check in TOP_LEVEL:
-        for cell in task_runs.ancestry(run):
-            if cell.other_process:
-                where = ("the task cell above" if cell.number == run.number else
-                         f"a cell you ran before the task cell (`{cell.first_line[:60]}`), "
-                         f"whose values it uses,")
-                return (f"{where} runs another program (a subprocess, os.system, "
-                        f"multiprocessing): the check cannot see what it computes, so it "
-                        f"cannot tell its values from the pack's. Compute them in the notebook "
-                        f"itself, run that cell, then this check again")
+    problem = trail_problem(check, run)
+    if problem is not None:
+        return problem
     for wanted in DRIVEN.get(check, ()):
         if wanted.position >= len(args):
             continue
@@ -343,12 +365,14 @@ def copied_result(check: str, args: tuple, run: task_runs.TaskRun) -> str | None
                 if leaf.shape == result.shape and np.allclose(leaf, result, rtol=1e-12,
                                                               atol=0.0):
                     what = given[position] if position < len(given) else "a value"
-                    return (f"{what} equals what {_runs(cell.entries.get(name, name), name)} "
-                            f"returned in a cell you ran before the task cell "
-                            f"(`{cell.first_line[:60]}`): the check cannot tell it from the "
-                            f"pack's answer. If you computed it yourself, restart the kernel "
-                            f"(Kernel → Restart Kernel), run the cells above the task without "
-                            f"that one, then the task cell and this check")
+                    return (f"{what} equals a value the pack's "
+                            f"{_public(cell.entries.get(name, name))} computed in a cell you "
+                            f"ran before the task cell (`{cell.first_line[:60]}`): the check "
+                            f"cannot tell it from the pack's answer. If that cell is one of the "
+                            f"notebook's whose code you changed, put its code back as it was. "
+                            f"If you computed the value yourself, restart the kernel (Kernel → "
+                            f"Restart Kernel), run the cells above the task without that one, "
+                            f"then the task cell and this check")
     return None
 
 

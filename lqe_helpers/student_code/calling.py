@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import inspect
 import os
@@ -16,6 +17,8 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NotWrittenYet, StudentCodeError, TimedOut, error_text, location
+from .outside import HEARING, starts_a_program
+from .outside import watching as watching_outside
 from .running import run_in_thread, run_with_alarm
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
@@ -77,7 +80,7 @@ _depth = 0
 #: whose every function is such machinery, and single functions registered by
 #: :func:`machinery_function` (the time limit's signal handler, a stand-in, a recorder).
 MACHINERY_MODULES = ("guards.py", "running.py")
-_MACHINERY_CODES: set[types.CodeType] = set()
+_MACHINERY_CODES: set[types.CodeType] = {function.__code__ for function in HEARING}
 
 
 def machinery_function(function: Callable) -> Callable:
@@ -155,6 +158,7 @@ class _Watch:
         self.allowed = frozenset(_code_of(function, "allow") for function in allow)
         self.pack = pack
         self.tripped = ""
+        self.outside = ""   # what it took from outside the notebook (student_code.outside)
 
     def forbidden(self, frame: types.FrameType) -> str:
         """The qualified name of ``frame``'s function if the student may not run it, or ""."""
@@ -187,14 +191,22 @@ class _Watch:
                     if name:
                         self.tripped = self.tripped or name
                         raise _Tripped
+                    if self.pack and starts_a_program(frame.f_code.co_filename):
+                        outside("runs another program")
 
-            sys.setprofile(profile)
-            try:
-                return function(*args)
-            except _Tripped:
-                return None
-            finally:
-                sys.setprofile(previous)
+            @machinery_function
+            def outside(what: str) -> None:
+                self.outside = self.outside or what
+                raise _Tripped
+
+            with watching_outside(outside) if self.pack else contextlib.nullcontext():
+                sys.setprofile(profile)
+                try:
+                    return function(*args)
+                except _Tripped:
+                    return None
+                finally:
+                    sys.setprofile(previous)
 
         watched.__name__ = getattr(function, "__name__", "watched")
         return watched
@@ -335,6 +347,11 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
         _depth -= 1
     replaced = _restore(before)
     moved = _restore_working_folder(folder)
+    if watch.outside:
+        raise failure(
+            f"{name} {watch.outside}{on}: a task's function computes its result from its "
+            f"inputs, in the notebook. The check cannot see how numbers from a file or another "
+            f"program were made, so it cannot tell them from the pack's answer")
     if watch.tripped:
         raise failure(
             f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "

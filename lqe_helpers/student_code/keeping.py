@@ -20,6 +20,7 @@ import numpy as np
 from .calling import call, function_name, machinery_function
 from .errors import NotSavedYet, StudentCodeError, error_text, short_repr
 from .guards import guarded
+from .outside import unheard
 from .task_runs import recorded
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
@@ -122,7 +123,8 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
             f"{name} is defined inside another function; save needs a function defined "
             f"at the top of a cell")
     try:
-        source = textwrap.dedent(inspect.getsource(function))
+        with unheard():  # the pack reading the student's code, not the student a file
+            source = textwrap.dedent(inspect.getsource(function))
         tree = ast.parse(source)
     except (OSError, TypeError, SyntaxError):
         raise StudentCodeError(
@@ -151,7 +153,8 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
                                f"rename or delete it, then run this cell again")
     if path.exists():
         try:
-            old = path.read_text("utf-8")
+            with unheard():
+                old = path.read_text("utf-8")
         except (OSError, UnicodeDecodeError):
             old = ""
         if old.partition("\n")[0] != SAVE_HEADER:
@@ -235,12 +238,15 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
         print(message)
         return _not_saved_yet(name, message)
     try:
-        source = path.read_text("utf-8")
+        with unheard():  # the pack reading the student's function, not the student a file
+            source = path.read_text("utf-8")
         code = compile(source, str(path), "exec")
     except (OSError, UnicodeDecodeError, SyntaxError, ValueError) as error:
         raise StudentCodeError(f"{shown} could not be read as Python: "
                                f"{error_text(error)}") from None
-    linecache.checkcache(str(path))
+    # the source a traceback quotes is the one loaded, and quoting it reads no file (a task
+    # cell's read of a file is refused: student_code.outside)
+    linecache.cache[str(path)] = (len(source), None, source.splitlines(True), str(path))
     namespace: dict[str, object] = {"__name__": f"{SAVE_FOLDER}.{name}",
                                     "__file__": str(path), "np": np, "__builtins__": builtins}
     call(exec, code, namespace, name=shown, rerun="run this cell again")

@@ -26,8 +26,8 @@ checks then behave as without it.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
-import functools
 import os
 import sys
 import types
@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import outside as outside_module
 from .calling import in_pack, machinery_function, pack_name
 from .cell_code import (
     argument_names,
@@ -46,6 +47,8 @@ from .cell_code import (
     read_names,
 )
 from .given_cells import is_given
+from .outside import starts_a_program
+from .outside import watching as listening_outside
 
 #: Task runs kept (the most recent last).
 KEPT_RUNS = 200
@@ -56,6 +59,10 @@ RESULT_SIZE = 64
 #: Of these, the most recent whose calls of the student's saved functions (their inputs and
 #: outputs, copied) are kept; older runs forget them, so memory stays bounded.
 RUNS_WITH_CALLS = 20
+#: The record's own modules, whose functions a cell's record leaves out of its pack calls.
+_OWN = (__name__, outside_module.__name__)
+#: Of each run, the uses of the outside kept (:attr:`TaskRun.outside`).
+OUTSIDE_KEPT = 5
 
 
 @dataclass
@@ -101,9 +108,11 @@ class TaskRun:
         In a cell of the student's (not given): the small numeric results (numbers and
         arrays of at most :data:`RESULT_SIZE` numbers, copied) of the pack's functions it
         ran, each with the function's name, at most :data:`RESULTS_KEPT`.
-    other_process : bool
-        Whether it ran another program (``subprocess``, ``os.system``, ``multiprocessing``,
-        a fork), whose work the record cannot see.
+    outside : list of str
+        What it took from outside the notebook, whose work the record cannot see: a file it
+        read, another program it ran (``subprocess``, ``os.system``, ``multiprocessing``, a
+        fork), each said as "reads the file answer.npy" (:mod:`.outside`), at most
+        :data:`OUTSIDE_KEPT`.
     saved_calls : list of SavedCall
         Its calls of the student's loaded functions.
     """
@@ -120,7 +129,7 @@ class TaskRun:
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
     entries: dict[str, str] = field(default_factory=dict)
     results: list[tuple[str, np.ndarray]] = field(default_factory=list)
-    other_process: bool = False
+    outside: list[str] = field(default_factory=list)
     saved_calls: list[SavedCall] = field(default_factory=list)
 
     @property
@@ -141,6 +150,7 @@ class _Record:
         self.current: TaskRun | None = None
         self.cell = ""          # the code of the cell running now
         self.previous_profile: Callable | None = None
+        self.listening: contextlib.ExitStack | None = None
         self.shells: set[int] = set()
 
     def pre_run_cell(self, info: object) -> None:
@@ -157,6 +167,10 @@ class _Record:
         keep_results = not run.given
         entry = ["", 0]  # the pack function the cell itself called last; pack frames open
 
+        def outside(what: str) -> None:
+            if what not in run.outside and len(run.outside) < OUTSIDE_KEPT:
+                run.outside.append(what)
+
         def noting(frame: types.FrameType, event: str, arg: object) -> None:
             if previous is not None:
                 previous(frame, event, arg)
@@ -165,8 +179,9 @@ class _Record:
                 name = pack_calls.get(code)
                 if name is None:
                     if not in_pack(code.co_filename):
-                        if _starts_a_process(code.co_filename):
-                            run.other_process = True
+                        if starts_a_program(code.co_filename):
+                            module = str(frame.f_globals.get("__name__", "subprocess"))
+                            outside(f"runs another program ({module.split('.')[0]})")
                         return
                     name = pack_calls[code] = pack_name(frame)
                 if not entry[1]:
@@ -174,7 +189,7 @@ class _Record:
                 entry[1] += 1
                 entries.setdefault(name, entry[0])
             elif event == "c_call" and arg in _PROCESS_CALLS:
-                run.other_process = True
+                outside(f"runs another program (os.{getattr(arg, '__name__', 'system')})")
             elif event == "return" and frame.f_code in pack_calls:
                 entry[1] = max(entry[1] - 1, 0)
                 if keep_results and len(results) < RESULTS_KEPT:
@@ -183,6 +198,8 @@ class _Record:
                         results.append((pack_calls[frame.f_code], kept))
 
         sys.setprofile(noting)
+        self.listening = contextlib.ExitStack()
+        self.listening.enter_context(listening_outside(outside))
 
     def post_run_cell(self, result: object) -> None:
         run = self._stop()
@@ -197,8 +214,11 @@ class _Record:
             return None
         sys.setprofile(self.previous_profile)
         self.previous_profile = None
+        if self.listening is not None:
+            self.listening.close()
+            self.listening = None
         run.pack_calls = {code: name for code, name in list(run.pack_calls.items())
-                          if not name.startswith(__name__)}
+                          if not name.startswith(_OWN)}
         self.runs.append(run)
         del self.runs[:-KEPT_RUNS]
         for old in self.runs[:-RUNS_WITH_CALLS]:
@@ -245,7 +265,7 @@ def run_for(check: str) -> TaskRun | None:
         return dataclasses.replace(  # as far as it ran: its pack calls up to this check
             now, completed=True, saved_calls=list(now.saved_calls),
             pack_calls={code: name for code, name in list(now.pack_calls.items())
-                        if not name.startswith(__name__)})
+                        if not name.startswith(_OWN)})
     for index in range(len(_RECORD.runs) - 1, -1, -1):
         run = _RECORD.runs[index]
         if names & run.defines or (run.task and run.not_written and names & run.mentions):
@@ -266,14 +286,6 @@ _PROCESS_CALLS = frozenset(getattr(os, name) for name in (
     "system", "fork", "forkpty", "execv", "execve", "execvp", "execvpe", "execl", "execle",
     "execlp", "execlpe", "posix_spawn", "posix_spawnp", "spawnv", "spawnve")
     if hasattr(os, name))
-
-
-@functools.lru_cache(maxsize=4096)
-def _starts_a_process(filename: str) -> bool:
-    """Whether code of ``filename`` is the standard library's way to run another process."""
-    parts = filename.replace(os.sep, "/").split("/")
-    return parts[-1] in {"subprocess.py", "pty.py"} or "multiprocessing" in parts or (
-        "concurrent" in parts and parts[-1] == "process.py")
 
 
 def _small_result(value: object) -> np.ndarray | None:

@@ -13,6 +13,8 @@ import contextlib
 import dataclasses
 import inspect
 import io
+import subprocess
+import sys
 
 import nbformat
 import numpy as np
@@ -559,9 +561,15 @@ def test_the_packs_answer_passed_on_without_a_name_fails_too(channel, folder):
     assert error is None and printed.startswith("✓ "), (error, printed)  # the right values
     error, printed = run_task("03_fusion", "check_fusion", task, earlier=(earlier,))
     assert isinstance(error, CheckFailed), error
-    assert ("C equals what the pack's model.observation_matrix, which runs its own "
-            "_matrices.observation returned in a cell you ran before the task cell") in str(error)
-    assert "restart the kernel" in str(error)
+    if channel == "a file":  # the task cell's read of the file is refused first
+        assert str(error).startswith("the task cell above reads the file kept_c.npy: the "
+                                     "check cannot see how numbers from a file"), error
+    else:
+        assert str(error).startswith(
+            "C equals a value the pack's model.observation_matrix computed in a cell you ran "
+            "before the task cell"), error
+        assert "<locals>" not in str(error) and "put its code back" in str(error), error
+        assert "restart the kernel" in str(error)
     assert printed == ""
 
 
@@ -574,7 +582,7 @@ def test_the_packs_answer_looked_at_before_the_task_cell_is_refused_with_the_way
             "print(model.measurement_noise_covariance([sigma_v, sigma_p]))\n")
     error, _printed = run_task("03_fusion", "check_fusion", None, earlier=(look,))
     assert isinstance(error, CheckFailed), error
-    assert str(error).startswith("R equals what the pack's"), error
+    assert str(error).startswith("R equals a value the pack's"), error
     assert "model.measurement_noise_covariance" in str(error), error
     assert "restart the kernel" in str(error)
 
@@ -788,4 +796,61 @@ def test_a_note_added_to_a_given_cell_leaves_it_the_notebooks(folder, monkeypatc
     before, _task, _check = cells_up_to("02_initial_covariance", "check_start_of_trial")
     assert any(source.endswith("# my note") for source in before)
     error, printed = run_task("02_initial_covariance", "check_start_of_trial", None)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+#: The fourth trial: the pack's answer made by another program, left in a file. The program
+#: runs in an earlier cell (os.system, subprocess) or beside the notebook (a terminal: here
+#: the test writes the file before the cells run); the task cell only reads the file.
+PROGRAM = ("import subprocess, sys\n"
+           "subprocess.run([sys.executable, '-c', 'import numpy as np; from lqe_helpers import "
+           "model; np.save(\"c.npy\", model.observation_matrix((\"vision\", \"proprioception\")));"
+           " np.save(\"r.npy\", model.measurement_noise_covariance([1.5, 1.5]))'], check=True)\n")
+SHELL = PROGRAM.replace("subprocess.run([sys.executable, '-c', ", "import shlex; os.system("
+                        "shlex.quote(sys.executable) + ' -c ' + shlex.quote(").replace(
+    "'], check=True)", "'))").replace("import subprocess, sys", "import os, sys")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("where", ["subprocess in an earlier cell", "os.system in an earlier cell",
+                                   "a program beside the notebook", "read in an earlier cell"])
+def test_the_packs_answer_left_in_a_file_by_another_program_fails(where, folder):
+    """The fourth trial: an earlier cell ran the pack in another program that wrote the
+    answer to a file, and the task cell only read the file: ✓. The record cannot trace a
+    file's numbers, so a task cell (or a cell of the student's it draws on) that reads a file
+    is refused, and says which file."""
+    read = "C = np.load('c.npy')\nR = np.load('r.npy')\n"
+    earlier: tuple[str, ...] = ()
+    if where == "a program beside the notebook":
+        subprocess.run([sys.executable, "-c", PROGRAM], check=True, cwd=folder)
+    else:
+        earlier = (SHELL if where.startswith("os.system") else PROGRAM,)
+    task = read
+    if where == "read in an earlier cell":
+        earlier, task = (PROGRAM, "kept_c = np.load('c.npy')\nkept_r = np.load('r.npy')\n"), (
+            "C = kept_c.copy()\nR = kept_r.copy()\n")
+    error, printed = run_task("03_fusion", "check_fusion", task, earlier=earlier, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)  # the right values
+    (folder / "c.npy").unlink()
+    (folder / "r.npy").unlink()
+    if where == "a program beside the notebook":
+        subprocess.run([sys.executable, "-c", PROGRAM], check=True, cwd=folder)
+    error, printed = run_task("03_fusion", "check_fusion", task, earlier=earlier)
+    assert isinstance(error, CheckFailed), error
+    assert "reads the file c.npy: the check cannot see how numbers from a file" in str(error), \
+        error
+    if where == "read in an earlier cell":
+        assert str(error).startswith("a cell you ran before the task cell (`kept_c = "), error
+    assert printed == ""
+
+
+@pytest.mark.slow
+def test_a_task_cell_that_imports_a_module_and_draws_a_figure_is_not_refused(folder):
+    """Files of the installation (a module imported for the first time, matplotlib's fonts)
+    are not a student's file."""
+    _before, task, _check = cells_up_to("03_fusion", "check_fusion")
+    extra = ("import io, fractions, matplotlib.pyplot as plt\n"
+             "fig, ax = plt.subplots()\nax.set_title('C and R')\nfig.savefig(io.BytesIO())\n"
+             "plt.close(fig)\n")
+    error, printed = run_task("03_fusion", "check_fusion", task + "\n" + extra, comment=False)
     assert error is None and printed.startswith("✓ "), (error, printed)

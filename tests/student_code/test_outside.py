@@ -1,0 +1,123 @@
+"""What a student's code takes from outside the notebook (``student_code.outside``): a file it
+reads, another program it runs. The fourth trial's loophole: numbers the pack computed in
+another program, read from a file."""
+
+from __future__ import annotations
+
+import linecache
+import os
+import subprocess
+import sys
+import threading
+
+import numpy as np
+import pytest
+
+import lqe_helpers
+from lqe_helpers import checks, student_code
+from lqe_helpers.student_code import outside
+
+
+@pytest.fixture
+def heard():
+    """What this thread's code takes from outside while the test runs."""
+    uses: list[str] = []
+    with outside.watching(uses.append):
+        yield uses
+
+
+def test_reading_a_file_is_heard_and_writing_one_is_not(tmp_path, heard, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    np.save("answer.npy", np.eye(2))
+    (tmp_path / "note.txt").write_text("written")
+    assert heard == []
+    np.load("answer.npy")
+    os.close(os.open(tmp_path / "note.txt", os.O_RDONLY))
+    assert heard == ["reads the file answer.npy", "reads the file note.txt"]
+
+
+def test_the_installations_files_are_not_the_students(heard):
+    with open(np.__file__, "rb"):
+        pass
+    with open(os.path.join(os.path.dirname(lqe_helpers.__file__), "model.py"), "rb"):
+        pass
+    assert heard == []
+
+
+def test_a_data_file_in_the_packs_folder_or_in_shared_memory_is_the_students(heard):
+    pack = os.path.dirname(lqe_helpers.__file__)
+    assert not outside.installation_file(os.path.join(pack, "answer.npy"))
+    assert not outside.installation_file("/dev/shm/answer.npy")
+    assert outside.installation_file(os.path.join(pack, "model.py"))
+
+
+def test_running_another_program_is_heard(heard):
+    os.system("true")
+    subprocess.run(["true"], check=True)
+    assert heard == ["runs another program (os.system)", "runs another program (subprocess.Popen)"]
+
+
+def test_another_threads_uses_are_not_this_threads(tmp_path, heard):
+    path = tmp_path / "answer.npy"
+    np.save(path, np.eye(2))
+    worker = threading.Thread(target=np.load, args=(path,))
+    worker.start()
+    worker.join()
+    assert heard == []
+
+
+def test_the_innermost_listener_hears_and_unheard_hears_nothing(tmp_path, heard):
+    path = tmp_path / "answer.npy"
+    np.save(path, np.eye(2))
+    inner: list[str] = []
+    with outside.watching(inner.append):
+        np.load(path)
+    with outside.unheard():
+        np.load(path)
+    assert heard == [] and inner == [f"reads the file {path}"]
+
+
+def test_a_function_task_that_reads_a_file_fails(tmp_path):
+    """A ``my_filter`` returning numbers another program left in a file: the check cannot
+    trace them, so the call fails, naming the file."""
+    path = tmp_path / "answer.npy"
+    np.save(path, np.eye(2))
+    with pytest.raises(checks.CheckFailed, match=r"^my_filter reads the file .*answer\.npy: a "
+                       r"task's function computes its result from its inputs"):
+        checks.machinery.call_student(lambda: np.load(path), name="my_filter", where="")
+    assert np.array_equal(student_code.call(lambda: np.load(path)), np.eye(2))  # no forbid
+
+
+def test_a_function_task_that_runs_another_program_fails():
+    def runs_the_pack_elsewhere():
+        output = subprocess.run([sys.executable, "-c", "print(1)"], capture_output=True,
+                                text=True, check=True).stdout
+        return float(output)
+
+    with pytest.raises(checks.CheckFailed, match=r"^my_filter runs another program"):
+        checks.machinery.call_student(runs_the_pack_elsewhere, name="my_filter", where="")
+
+
+def test_quoting_a_loaded_functions_source_reads_no_file(tmp_path, heard):
+    """A traceback or warning through a loaded ``my_filter`` quotes its source: that is not a
+    read of a file by the student's task cell."""
+    def my_filter(y):
+        return y
+
+    student_code.save(my_filter, folder=tmp_path)
+    student_code.load("my_filter", folder=tmp_path)
+    path = str(tmp_path / "my_filter.py")
+    assert "def my_filter(y):" in "".join(linecache.getlines(path))
+    assert heard == []
+
+
+def test_a_file_opened_to_be_written_afresh_is_not_read(tmp_path, heard):
+    import tempfile
+    with tempfile.NamedTemporaryFile("w+", dir=tmp_path, delete=False) as handle:
+        handle.write("1")
+    with open(tmp_path / "b.txt", "w+") as handle:
+        handle.write("1")
+    assert heard == []
+    with open(tmp_path / "b.txt", "a+"):
+        pass
+    assert heard == [f"reads the file {tmp_path / 'b.txt'}"]
