@@ -415,15 +415,10 @@ def outputs_of(function: Callable, name: str) -> Iterator[list[object] | None]:
         yield None
         return
     outputs: list[object] = []
-
-    def noting(*args: object, **kwargs: object) -> object:
-        output = watched(*args, **kwargs)
-        outputs.append(output.copy() if isinstance(output, np.ndarray) else output)
-        return output
-
-    noting.__name__ = noting.__qualname__ = getattr(watched, "__name__", name)
-    noting.__wrapped__ = watched  # type: ignore[attr-defined]
-    namespace[name] = machinery_function(noting)
+    noting = task_runs.recorded(
+        name, watched, note=machinery_function(
+            lambda _name, _args, output: outputs.append(task_runs.copied(output))))
+    namespace[name] = noting
     try:
         yield outputs
     finally:

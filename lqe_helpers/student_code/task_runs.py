@@ -367,22 +367,24 @@ def note_call(name: str, args: tuple, output: object) -> None:
     """Record a call of the loaded function ``name`` in the task cell running now, if any."""
     run = _RECORD.current
     if run is not None:
-        copies = tuple(map(_copied, args))
-        kept = output.copy() if isinstance(output, np.ndarray) else output
-        run.saved_calls.append(SavedCall(name, copies, kept))
+        copies = tuple(map(copied, args))
+        run.saved_calls.append(SavedCall(name, copies, copied(output)))
 
 
 @machinery_function
-def _copied(value: object) -> object:
+def copied(value: object) -> object:
+    """A copy of ``value`` if it is an array (the student may change it in place later)."""
     return value.copy() if isinstance(value, np.ndarray) else value
 
 
-def recorded(name: str, function: Callable) -> Callable:
-    """``function`` (a loaded saved function) noting each of its calls with :func:`note_call`."""
+def recorded(name: str, function: Callable,
+             note: Callable[[str, tuple, object], None] = note_call) -> Callable:
+    """``function`` (a student's function) noting each of its calls (name, arguments,
+    output) with ``note``: by default :func:`note_call`, the task cell's record."""
 
     def recording(*args: object, **kwargs: object) -> object:
         output = function(*args, **kwargs)
-        note_call(name, args + tuple(kwargs.values()), output)
+        note(name, args + tuple(kwargs.values()), output)
         return output
 
     recording.__name__ = recording.__qualname__ = getattr(function, "__name__", name)

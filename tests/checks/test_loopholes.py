@@ -211,7 +211,7 @@ MACHINERY = {
     "lqe_helpers.student_code.keeping._not_saved_yet.<locals>.stand_in",
     "lqe_helpers.student_code.task_runs.recorded.<locals>.recording",
     "lqe_helpers.student_code.task_runs.note_call",
-    "lqe_helpers.student_code.task_runs._copied",
+    "lqe_helpers.student_code.task_runs.copied",
     "lqe_helpers.student_code.guards._sized",
     "lqe_helpers.student_code.guards.filter_inputs_problem",
     "lqe_helpers.student_code.guards.compensate_inputs_problem",
