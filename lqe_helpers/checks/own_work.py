@@ -42,7 +42,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..scenario import Scenario
-from ..student_code import task_runs
+from ..student_code import outside, task_runs
 from ..student_code.calling import machinery_function
 from .machinery import FUNCTION_RTOL, CheckFailed, close
 
@@ -240,10 +240,9 @@ def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
             where = ("the task cell above" if cell.number == run.number else
                      f"a cell you ran before the task cell (`{cell.first_line[:60]}`), whose "
                      f"values it uses,")
-            return (f"{where} {cell.outside[0]}: the check cannot see how numbers from a "
-                    f"file or another program were made, so it cannot tell them from the "
-                    f"pack's answer. Compute them in the notebook itself, with your own code, "
-                    f"run that cell, then this check again")
+            return (f"{where} {cell.outside[0]}. {outside.UNTRACEABLE}. Compute them in "
+                    f"the notebook itself, with your own code, run that cell, then this check "
+                    f"again")
     return None
 
 

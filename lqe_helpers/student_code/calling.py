@@ -17,9 +17,9 @@ from pathlib import Path
 import numpy as np
 
 from .errors import NotWrittenYet, StudentCodeError, TimedOut, error_text, location
-from .outside import HEARING, starts_a_program
+from .outside import HEARING, LOST_WATCH, UNTRACEABLE, c_call_use, dropping, starts_a_program
 from .outside import watching as watching_outside
-from .running import run_in_thread, run_with_alarm
+from .running import is_time_limit_hook, run_in_thread, run_with_alarm
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -184,15 +184,21 @@ class _Watch:
             previous = sys.getprofile()
 
             def profile(frame: types.FrameType, event: str, arg: object) -> None:
-                if previous is not None:
-                    previous(frame, event, arg)
-                if event == "call":
-                    name = self.forbidden(frame)
-                    if name:
-                        self.tripped = self.tripped or name
-                        raise _Tripped
-                    if self.pack and starts_a_program(frame.f_code.co_filename):
-                        outside("runs another program")
+                try:
+                    if previous is not None:
+                        previous(frame, event, arg)
+                    if event == "call":
+                        name = self.forbidden(frame)
+                        if name:
+                            self.tripped = self.tripped or name
+                            raise _Tripped
+                        if self.pack and starts_a_program(frame.f_code.co_filename):
+                            outside("runs another program")
+                    elif event == "c_call" and self.pack and c_call_use(arg):
+                        outside(c_call_use(arg))
+                except BaseException:  # Python drops a hook that raises: not the student's doing
+                    dropping()
+                    raise
 
             @machinery_function
             def outside(what: str) -> None:
@@ -202,14 +208,26 @@ class _Watch:
             with watching_outside(outside) if self.pack else contextlib.nullcontext():
                 sys.setprofile(profile)
                 try:
-                    return function(*args)
+                    result = function(*args)
                 except _Tripped:
                     return None
+                else:
+                    if self.pack and not _watch_kept(profile):
+                        self.outside = self.outside or LOST_WATCH
+                    return result
                 finally:
                     sys.setprofile(previous)
 
         watched.__name__ = getattr(function, "__name__", "watched")
         return watched
+
+
+@machinery_function
+def _watch_kept(profile: Callable) -> bool:
+    """Whether the profile hook ``profile`` still watches this thread, or the time limit's
+    (:mod:`.running`) took it over to stop the call."""
+    current = sys.getprofile()
+    return current is profile or is_time_limit_hook(current)
 
 
 def _code_of(function: Callable, parameter: str) -> types.CodeType:
@@ -350,8 +368,7 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
     if watch.outside:
         raise failure(
             f"{name} {watch.outside}{on}: a task's function computes its result from its "
-            f"inputs, in the notebook. The check cannot see how numbers from a file or another "
-            f"program were made, so it cannot tell them from the pack's answer")
+            f"inputs, in the notebook. {UNTRACEABLE}")
     if watch.tripped:
         raise failure(
             f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "

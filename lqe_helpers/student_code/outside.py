@@ -10,6 +10,13 @@ file for the task cell to read. :func:`watching` notes, through one audit hook
 such use by the code running in the current thread and tells a listener what it was: "reads
 the file answer.npy", "runs another program (os.system)".
 
+The student's own code switching the watch off is news too: replacing the profile hook
+through which the pack sees which functions run (``sys.setprofile``; Python announces it too
+when it drops a hook that raised, which the pack's hooks say first: :func:`dropping`),
+starting a thread
+(whose calls no hook of this thread sees), or making a function from another's code by hand
+(``code.replace``, ``types.FunctionType``: a pack function under another file's name).
+
 Files of the installation are not news: Python's and its packages' (``sys.prefix``, the
 site folders), the pack's modules, the system's folders, matplotlib's and IPython's settings
 and caches. Neither are writes: what a cell writes it has computed in the notebook.
@@ -17,6 +24,7 @@ and caches. Neither are writes: what a cell writes it has computed in the notebo
 
 from __future__ import annotations
 
+import _thread
 import contextlib
 import functools
 import os
@@ -36,6 +44,24 @@ PROGRAM_EVENTS = frozenset({
 OTHER_SOURCES = {"sqlite3.connect": "opens the database {0}",
                  "socket.connect": "opens a network connection",
                  "urllib.Request": "opens the address {0}"}
+#: The audit events of the student's own code changing what the pack's watch sees.
+TAMPERING = {"sys.setprofile": "switches off the pack's watch of the functions it runs "
+                               "(sys.setprofile)",
+             "code.__new__": "makes a code object by hand (code.replace, types.CodeType)",
+             "function.__new__": "makes a function by hand (types.FunctionType)"}
+#: The C functions that start or become another program (os.system, fork, exec, spawn).
+PROCESS_CALLS = frozenset(getattr(os, name) for name in (
+    "system", "fork", "forkpty", "execv", "execve", "execvp", "execvpe", "execl", "execle",
+    "execlp", "execlpe", "posix_spawn", "posix_spawnp", "spawnv", "spawnve")
+    if hasattr(os, name))
+#: What a profile hook's ``c_call`` of a watched code says when it leaves the watch.
+STARTS_A_THREAD = "starts another thread, whose calls the pack cannot watch"
+#: What a watch says when its profile hook was gone after the code ran.
+LOST_WATCH = ("switched off the pack's watch of the functions it runs (a RecursionError "
+              "caught inside it, or sys.setprofile)")
+#: Why a check refuses numbers made that way.
+UNTRACEABLE = ("The check cannot see how numbers from a file, another program or code it "
+               "cannot watch were made, so it cannot tell them from the pack's answer")
 #: The system's folders (never a place a student's program leaves numbers), but /dev/shm.
 SYSTEM_FOLDERS = ("/proc", "/sys", "/etc", "/usr", "/lib", "/lib64", "/bin", "/sbin", "/dev")
 #: Suffixes of module files: read from the pack's own folder when a module is imported.
@@ -44,6 +70,8 @@ MODULE_SUFFIXES = (".py", ".pyc", ".so", ".pyd")
 _PACK_FOLDER = os.path.realpath(Path(__file__).resolve().parent.parent)
 
 _listeners: dict[int, list[Callable[[str], None]]] = {}
+_dropping: set[int] = set()  # the threads whose profile hook of the pack is raising
+_time_up: set[int] = set()   # the threads whose call a time limit is stopping
 _hooked: list[bool] = []  # [True] once the audit hook is added (changed in place, so that a
                           # check's snapshot of the pack's globals sees no change)
 
@@ -79,13 +107,40 @@ def _ignore(what: str) -> None:
     """A listener that hears nothing."""
 
 
+def dropping() -> None:
+    """Say that a profile hook of the pack raises in this thread now: Python drops it, and
+    the ``sys.setprofile`` event that announces it is not the student's."""
+    _dropping.add(threading.get_ident())
+
+
+def time_is_up(thread: int, up: bool = True) -> None:
+    """While a time limit stops a call in ``thread`` (``up``), its exceptions land anywhere,
+    in a profile hook too, which Python then drops: those ``sys.setprofile`` events are not
+    the student's."""
+    if up:
+        _time_up.add(thread)
+    else:
+        _time_up.discard(thread)
+
+
 def _heard(event: str, args: tuple) -> None:
+    if event == "sys.setprofile" and (_dropping or _time_up):
+        thread = threading.get_ident()
+        if thread in _time_up:
+            return
+        if thread in _dropping:
+            _dropping.discard(thread)
+            return
     if not _listeners:
         return
     stack = _listeners.get(threading.get_ident())
     if not stack:
         return
-    what = use_of_outside(event, args)
+    if event in TAMPERING:  # news only from the student's own code, not a library's
+        caller = sys._getframe(1).f_code.co_filename
+        what = "" if installation_file(caller) else TAMPERING[event]
+    else:
+        what = use_of_outside(event, args)
     if what:
         stack[-1](what)
 
@@ -113,6 +168,16 @@ def use_of_outside(event: str, args: tuple) -> str:
     if installation_file(path):
         return ""
     return f"reads the file {_shown(path)}"
+
+
+def c_call_use(function: object) -> str:
+    """What a profile hook's ``c_call`` of the built-in ``function`` takes from outside the
+    watch, or "": another program (``os.system``, fork, exec), another thread."""
+    if function is _thread.start_new_thread:
+        return STARTS_A_THREAD
+    if function in PROCESS_CALLS:
+        return f"runs another program (os.{getattr(function, '__name__', 'system')})"
+    return ""
 
 
 @functools.lru_cache(maxsize=4096)
@@ -163,4 +228,4 @@ def _shown(path: str) -> str:
 #: What runs inside a student's function when it uses the outside: the audit hook and what
 #: it asks (``calling`` lets a watched function run them, as machinery).
 HEARING = (_heard, use_of_outside, installation_file, _installation_folders.__wrapped__,
-           _shown)
+           _shown, c_call_use, dropping, time_is_up)

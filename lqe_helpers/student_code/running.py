@@ -45,6 +45,7 @@ import types
 from collections.abc import Callable
 
 from .errors import is_own_code
+from .outside import dropping, time_is_up
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
 
@@ -139,10 +140,14 @@ class _Stopper:
         return self.hook
 
     def profile(self, frame: types.FrameType, event: str, arg: object) -> None:
-        if self.chained is not None:
-            self.chained(frame, event, arg)
-        if self.stopping:
-            self.retrace(frame)
+        try:
+            if self.chained is not None:
+                self.chained(frame, event, arg)
+            if self.stopping:
+                self.retrace(frame)
+        except BaseException:  # Python drops a hook that raises: not the student's doing
+            dropping()
+            raise
 
     def mark(self, frame: types.FrameType | None, until_traced: bool = False) -> None:
         """Trace the student's own frames from ``frame`` up to :attr:`home` (any thread);
@@ -164,7 +169,7 @@ class _Stopper:
     def stop(self, frame: types.FrameType | None) -> None:
         """From now on every line of the call raises (see the module); in its own thread."""
         if not self.stopping:
-            self.stopping = True
+            self.time_is_up()
             self.chained = sys.getprofile()
         if sys.getprofile() != self.profile:  # at first, or removed by an error inside it
             sys.setprofile(self.profile)
@@ -180,11 +185,23 @@ class _Stopper:
             frame = frame.f_back
         return False
 
+    def time_is_up(self) -> None:
+        """From now on, stop the call (:attr:`stopping`); its thread's hooks may drop."""
+        self.stopping = True
+        time_is_up(self.thread)
+
     def end(self, previous_trace: Callable | None, previous_profile: Callable | None) -> None:
         """The call has ended: put back the hooks found before it."""
         self.stopping = False
+        time_is_up(self.thread, False)
         sys.settrace(previous_trace)
         sys.setprofile(previous_profile)
+
+
+
+def is_time_limit_hook(function: object) -> bool:
+    """Whether ``function`` is the profile hook a time limit puts in place to stop a call."""
+    return getattr(function, "__func__", None) is _Stopper.profile
 
 
 def _unraisable(stopper: _Stopper, previous: Callable) -> Callable:
@@ -290,7 +307,7 @@ def run_in_thread(function: Callable, args: tuple, limit: float) -> tuple[str, o
         worker.join(_GRACE)
         return box.get("outcome", ("raised", KeyboardInterrupt()))  # type: ignore[return-value]
     if worker.is_alive():
-        stopper.stopping = True
+        stopper.time_is_up()
         stopper.give_room()
         _send(worker, TimeIsUp)
         deadline = time.monotonic() + _GRACE

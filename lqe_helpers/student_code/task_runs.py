@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
-import os
 import sys
 import types
 from collections.abc import Callable
@@ -47,7 +46,7 @@ from .cell_code import (
     read_names,
 )
 from .given_cells import is_given
-from .outside import starts_a_program
+from .outside import LOST_WATCH, c_call_use, dropping, starts_a_program
 from .outside import watching as listening_outside
 
 #: Task runs kept (the most recent last).
@@ -150,6 +149,7 @@ class _Record:
         self.current: TaskRun | None = None
         self.cell = ""          # the code of the cell running now
         self.previous_profile: Callable | None = None
+        self.noting: Callable | None = None   # the running cell's profile hook
         self.listening: contextlib.ExitStack | None = None
         self.shells: set[int] = set()
 
@@ -172,32 +172,37 @@ class _Record:
                 run.outside.append(what)
 
         def noting(frame: types.FrameType, event: str, arg: object) -> None:
-            if previous is not None:
-                previous(frame, event, arg)
-            if event == "call":
-                code = frame.f_code
-                name = pack_calls.get(code)
-                if name is None:
-                    if not in_pack(code.co_filename):
-                        if starts_a_program(code.co_filename):
-                            module = str(frame.f_globals.get("__name__", "subprocess"))
-                            outside(f"runs another program ({module.split('.')[0]})")
-                        return
-                    name = pack_calls[code] = pack_name(frame)
-                if not entry[1]:
-                    entry[0] = name
-                entry[1] += 1
-                entries.setdefault(name, entry[0])
-            elif event == "c_call" and arg in _PROCESS_CALLS:
-                outside(f"runs another program (os.{getattr(arg, '__name__', 'system')})")
-            elif event == "return" and frame.f_code in pack_calls:
-                entry[1] = max(entry[1] - 1, 0)
-                if keep_results and len(results) < RESULTS_KEPT:
-                    kept = _small_result(arg)
-                    if kept is not None:
-                        results.append((pack_calls[frame.f_code], kept))
+            try:
+                if previous is not None:
+                    previous(frame, event, arg)
+                if event == "call":
+                    code = frame.f_code
+                    name = pack_calls.get(code)
+                    if name is None:
+                        if not in_pack(code.co_filename):
+                            if starts_a_program(code.co_filename):
+                                module = str(frame.f_globals.get("__name__", "subprocess"))
+                                outside(f"runs another program ({module.split('.')[0]})")
+                            return
+                        name = pack_calls[code] = pack_name(frame)
+                    if not entry[1]:
+                        entry[0] = name
+                    entry[1] += 1
+                    entries.setdefault(name, entry[0])
+                elif event == "c_call" and c_call_use(arg):
+                    outside(c_call_use(arg))
+                elif event == "return" and frame.f_code in pack_calls:
+                    entry[1] = max(entry[1] - 1, 0)
+                    if keep_results and len(results) < RESULTS_KEPT:
+                        kept = _small_result(arg)
+                        if kept is not None:
+                            results.append((pack_calls[frame.f_code], kept))
+            except BaseException:  # Python drops a hook that raises: not the student's doing
+                dropping()
+                raise
 
         sys.setprofile(noting)
+        self.noting = noting
         self.listening = contextlib.ExitStack()
         self.listening.enter_context(listening_outside(outside))
 
@@ -212,6 +217,9 @@ class _Record:
         run, self.current = self.current, None
         if run is None:
             return None
+        if sys.getprofile() is not self.noting and len(run.outside) < OUTSIDE_KEPT:
+            run.outside.append(LOST_WATCH)
+        self.noting = None
         sys.setprofile(self.previous_profile)
         self.previous_profile = None
         if self.listening is not None:
@@ -268,6 +276,8 @@ def run_for(check: str) -> TaskRun | None:
                         if not name.startswith(_OWN)})
     for index in range(len(_RECORD.runs) - 1, -1, -1):
         run = _RECORD.runs[index]
+        if run.given:  # a cell the notebook gives makes the task's inputs, not its answer
+            continue
         if names & run.defines or (run.task and run.not_written and names & run.mentions):
             # a later try at the same task (the same ``# Task:`` comment) that stopped
             # before making them is the attempt to judge, not this older run
@@ -279,13 +289,6 @@ def run_for(check: str) -> TaskRun | None:
             return run
     tasks = [run for run in _RECORD.runs if run.task]
     return tasks[-1] if tasks else None
-
-
-#: The C functions that start or become another program (os.system, fork, exec, spawn).
-_PROCESS_CALLS = frozenset(getattr(os, name) for name in (
-    "system", "fork", "forkpty", "execv", "execve", "execvp", "execvpe", "execl", "execle",
-    "execlp", "execlpe", "posix_spawn", "posix_spawnp", "spawnv", "spawnve")
-    if hasattr(os, name))
 
 
 def _small_result(value: object) -> np.ndarray | None:

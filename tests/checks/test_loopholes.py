@@ -33,7 +33,7 @@ from cell_runner import CellRunner
 
 import lqe_helpers
 from lqe_helpers.checks import CheckFailed, machinery, own_work
-from lqe_helpers.student_code import calling
+from lqe_helpers.student_code import calling, outside
 
 #: The worked answers of the function tasks (what the student's function computes after
 #: the pack's call), with arguments of each task's check, by the function the task asks for.
@@ -134,8 +134,18 @@ def test_the_walk_finds_the_packs_functions_public_and_private() -> None:
         assert name in names, name
 
 
+@pytest.fixture
+def enter_is_a_library(monkeypatch):
+    """:func:`enter` sets its own profile hook, which a student's code may not: for these
+    tests its file counts as a library's."""
+    library = outside.installation_file
+    monkeypatch.setattr(outside, "installation_file",
+                        lambda path: path == __file__ or library(path))
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("task", list(FUNCTION_TASKS))
+@pytest.mark.usefixtures("enter_is_a_library")
 def test_no_function_of_the_pack_passes_as_a_function_tasks_answer(task) -> None:
     """Every pack function, called at the top and in the middle (behind a bare except) of
     the task's worked answer: the call fails naming it, except the machinery."""
@@ -223,6 +233,12 @@ MACHINERY = {
     "lqe_helpers.student_code.outside.installation_file",
     "lqe_helpers.student_code.outside._installation_folders",
     "lqe_helpers.student_code.outside._shown",
+    "lqe_helpers.student_code.outside.c_call_use",
+    "lqe_helpers.student_code.outside.dropping",
+    "lqe_helpers.student_code.outside.time_is_up",
+    "lqe_helpers.student_code.running._Stopper.time_is_up",
+    "lqe_helpers.student_code.calling._watch_kept",
+    "lqe_helpers.student_code.running.is_time_limit_hook",
 }
 
 
@@ -232,6 +248,7 @@ def test_the_machinery_is_what_wraps_a_loaded_function_and_nothing_else() -> Non
 
 
 @pytest.mark.slow
+@pytest.mark.usefixtures("enter_is_a_library")
 def test_every_function_of_the_pack_a_task_cell_runs_is_refused_by_each_task_forbidding_it():
     """Each pack function entered in a task cell is in its record; each top-level and
     one-trial check refuses it exactly when its forbidden set covers it."""

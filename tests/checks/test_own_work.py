@@ -26,7 +26,7 @@ from test_checks_background import eyes_closed
 from lqe_helpers import _engine, bias_model, checks, experiments, prediction
 from lqe_helpers.checks import CheckFailed, own_work
 from lqe_helpers.scenario import DEFAULT
-from lqe_helpers.student_code import task_runs
+from lqe_helpers.student_code import outside, task_runs
 
 
 @pytest.fixture
@@ -562,7 +562,7 @@ def test_the_packs_answer_passed_on_without_a_name_fails_too(channel, folder):
     error, printed = run_task("03_fusion", "check_fusion", task, earlier=(earlier,))
     assert isinstance(error, CheckFailed), error
     if channel == "a file":  # the task cell's read of the file is refused first
-        assert str(error).startswith("the task cell above reads the file kept_c.npy: the "
+        assert str(error).startswith("the task cell above reads the file kept_c.npy. The "
                                      "check cannot see how numbers from a file"), error
     else:
         assert str(error).startswith(
@@ -837,7 +837,7 @@ def test_the_packs_answer_left_in_a_file_by_another_program_fails(where, folder)
         subprocess.run([sys.executable, "-c", PROGRAM], check=True, cwd=folder)
     error, printed = run_task("03_fusion", "check_fusion", task, earlier=earlier)
     assert isinstance(error, CheckFailed), error
-    assert "reads the file c.npy: the check cannot see how numbers from a file" in str(error), \
+    assert "reads the file c.npy. The check cannot see how numbers from a file" in str(error), \
         error
     if where == "read in an earlier cell":
         assert str(error).startswith("a cell you ran before the task cell (`kept_c = "), error
@@ -854,3 +854,52 @@ def test_a_task_cell_that_imports_a_module_and_draws_a_figure_is_not_refused(fol
              "plt.close(fig)\n")
     error, printed = run_task("03_fusion", "check_fusion", task + "\n" + extra, comment=False)
     assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+ANSWER = ("from lqe_helpers import model\nC = model.observation_matrix(FUSED)\n"
+          "R = model.measurement_noise_covariance([sigma_v, sigma_p])\n")
+#: Ways the student's own code takes its work out of the record's sight (found after the
+#: fourth trial): the pack's answer computed with the profile hook switched off, in another
+#: thread, or by a copy of the pack's function under another file's name.
+UNWATCHED = {
+    "sys.setprofile": ("import sys\nsys.setprofile(None)\n" + ANSWER,
+                       "switches off the pack's watch of the functions it runs (sys.setprofile)"),
+    "a thread": ("import threading\n_t = threading.Thread(target=exec, args=(\n"
+                 + repr(ANSWER) + ", globals()))\n_t.start()\n_t.join()\n",
+                 "starts another thread, whose calls the pack cannot watch"),
+    "code.replace": ("import types\nfrom lqe_helpers import _matrices\n"
+                     "def _mine(f):\n"
+                     "    return types.FunctionType(f.__code__.replace(co_filename='mine.py'),\n"
+                     "                              f.__globals__)\n"
+                     "C = _mine(_matrices.observation)(2)\n"
+                     "R = _mine(_matrices.noise_covariance)(np.array([sigma_v, sigma_p]))\n",
+                     "makes a code object by hand"),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("how", list(UNWATCHED))
+def test_the_packs_answer_made_out_of_the_records_sight_fails(how, folder):
+    """Before this, each passed with ✓: the record saw no pack function run."""
+    task, said = UNWATCHED[how]
+    error, printed = run_task("03_fusion", "check_fusion", task)
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert str(error).startswith(f"the task cell above {said}"), error
+    assert "cannot tell them from the pack's answer" in str(error), error
+    assert printed == ""
+
+
+def test_a_task_cell_that_loses_the_records_hook_is_refused(folder):
+    """Python switches a profile hook off when it raises (a RecursionError inside it), with
+    no audit event: a cell whose hook is gone at its end says so, and its check refuses."""
+    runner = CellRunner()
+    try:
+        lose = ("from lqe_helpers.student_code import outside\nimport sys\n"
+                "with outside.unheard():\n    sys.setprofile(None)\n")
+        assert runner.run("# Task: C and R\n" + lose + "C = R = 1\n") is None
+        run = task_runs._RECORD.runs[-1]
+        assert run.outside == [outside.LOST_WATCH]
+        assert own_work.trail_problem("check_fusion", run).startswith(
+            "the task cell above switched off the pack's watch of the functions it runs")
+    finally:
+        runner.close()

@@ -121,3 +121,42 @@ def test_a_file_opened_to_be_written_afresh_is_not_read(tmp_path, heard):
     with open(tmp_path / "b.txt", "a+"):
         pass
     assert heard == [f"reads the file {tmp_path / 'b.txt'}"]
+
+
+@pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
+@pytest.mark.parametrize("how", ["sys.setprofile", "C's PyEval_SetProfile", "a thread",
+                                 "code.replace"])
+def test_a_function_task_that_leaves_the_watch_is_refused(how):
+    """A function task's answer computed by the pack out of the watch's sight: with the
+    profile hook off (switched off, or lost through C), in another thread, or by a copy of
+    the pack's function under another file's name. Each passed before."""
+    import ctypes
+    import types
+
+    from lqe_helpers import model
+
+    def my_transition_matrix(dt):
+        found = []
+        if how == "sys.setprofile":
+            sys.setprofile(None)
+        elif how == "C's PyEval_SetProfile":
+            ctypes.pythonapi.PyEval_SetProfile(None, None)
+        if how == "a thread":
+            thread = threading.Thread(target=lambda: found.append(model.transition_matrix(dt)))
+            thread.start()
+            thread.join()
+        elif how == "code.replace":
+            copy = types.FunctionType(
+                model.transition_matrix.__code__.replace(co_filename="mine.py"),
+                model.transition_matrix.__globals__)
+            found.append(copy(dt))
+        else:
+            found.append(model.transition_matrix(dt))
+        return np.array(found[0])
+
+    said = {"sys.setprofile": "switches off the pack's watch of the functions it runs",
+            "C's PyEval_SetProfile": "switches off the pack's watch of the functions it runs",
+            "a thread": "starts another thread",
+            "code.replace": "makes a code object by hand"}[how]
+    with pytest.raises(checks.CheckFailed, match=f"my_transition_matrix {said}"):
+        checks.check_transition_matrix(my_transition_matrix, model.transition_matrix(0.01))
