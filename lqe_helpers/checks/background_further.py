@@ -21,7 +21,7 @@ import numpy as np
 from .. import experiments, metrics, model
 from ..prediction import propagate_covariance
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import judge, judge_interval
 from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
@@ -31,6 +31,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback

@@ -16,7 +16,7 @@ import numpy as np
 
 from .. import bias_model, experiments, metrics
 from ..scenario import DEFAULT
-from .judging import burn_in_slips, interval_mistakes, judge_interval
+from .judging import burn_in_slips, judge_interval
 from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
@@ -27,6 +27,7 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback

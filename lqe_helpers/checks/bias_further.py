@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import bias_model, experiments, metrics
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import judge, judge_interval
 from .machinery import (
     INTERVAL_RTOL,
     MATRIX_RTOL,
@@ -33,6 +33,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback

@@ -26,7 +26,7 @@ from ..scenario import DEFAULT
 from ..simulation import delay_signal
 from . import compensation_cases
 from .compensation_cases import COMPENSATE_ARGS, COMPENSATION_MISTAKES, Case, mistaken
-from .judging import CM_PER_M, interval_mistakes, judge_interval
+from .judging import CM_PER_M, judge_interval
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -43,6 +43,7 @@ from .machinery import (
     tolerance_text,
 )
 from .own_work import FUNCTION_TASKS
+from .paired_mistakes import interval_mistakes, unit_mistakes
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -403,6 +404,7 @@ def check_delay_difference(gain: metrics.Interval, won_back: metrics.Interval) -
         "is the paired difference delayed − compensated in cm²":
             metrics.mean_ci95((delayed - predicted) / (delayed - now)),
     }
+    mistakes.update(unit_mistakes(delayed, predicted, "the delayed MSE", "the compensated MSE"))
     judge_interval("gain", gain, metrics.mean_ci95(delayed - predicted), INTERVAL_RTOL,
                    unit="cm²", what="the paired difference delayed − compensated MSE "
                    "recomputed from the task's inputs",

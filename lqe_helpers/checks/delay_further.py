@@ -20,8 +20,9 @@ from ..scenario import DEFAULT
 from ..simulation import delay_signal
 from .delay import monte_carlo_mses
 from .delay_sweep import prediction_theory, sweep
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .judging import judge, judge_interval, mse_mistakes
 from .machinery import INTERVAL_RTOL, MSE_RTOL, passed, tolerance_text
+from .paired_mistakes import interval_mistakes
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 

@@ -23,7 +23,6 @@ from .initial_covariance import P0_NAMES, QUESTION_P0
 from .judging import (
     CM_PER_M,
     burn_in_slips,
-    interval_mistakes,
     judge,
     judge_interval,
     mse_mistakes,
@@ -39,6 +38,7 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes, unit_mistakes
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -441,7 +441,10 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
                    functools.partial(per_run, "fused", "vision", "mse_fused", mse_fused))
     vision, fused = values["vision_after"], values["fused_after"]
     mistakes = {
-        **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE"),
+        **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE",
+                            readings=tuple(
+                                ((values[kind] - values[f"{kind}_readings"][..., 0]) ** 2)
+                                [..., burn:].mean(axis=-1) for kind in ("vision", "fused"))),
         "it is the difference over the whole trial; difference is the one after the first "
         "second (from burn_in on)":
             metrics.mean_ci95(values["vision_whole"] - values["fused_whole"]),
@@ -457,6 +460,7 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
         mistakes[f"it leaves out the first {burn * DEFAULT.dt:g} sample(s): the burn-in is "
                  f"{burn * DEFAULT.dt:g} s, which is {burn} samples"] = (
             metrics.mean_ci95(values["vision_seconds"] - values["fused_seconds"]))
+    mistakes.update(unit_mistakes(vision, fused, "the vision-only MSE", "the fused MSE"))
     judge_interval("difference", difference, metrics.mean_ci95(vision - fused), INTERVAL_RTOL,
                    unit="cm²", mistakes=mistakes,
                    what="the paired difference vision only − fused after the first second, "

@@ -23,10 +23,10 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
+from .convergence_slips import BAND_FACTOR, OTHER_FACTORS, crossing_times
 from .judging import (
     CM_PER_M,
     burn_in_slips,
-    interval_mistakes,
     judge,
     judge_interval,
     judge_seconds,
@@ -43,6 +43,7 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes, unit_mistakes
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -271,38 +272,12 @@ def check_start_of_trial(P0_small: np.ndarray, P0_large: np.ndarray,
 # Task 2: convergence times of the Monte Carlo mean
 # ------------------------------------------------------------------------------------------
 
-def crossing_times(curve: np.ndarray, dt: float) -> dict[str, float]:
-    """Times (s) a convergence time takes under the usual misreadings of its definition.
-
-    ``curve`` is the right squared-error curve (cm², shape (n,)); the keys name the
-    mistake, for the checks' messages.
-    """
-    n = curve.size
-    right = float(metrics.convergence_time(curve, dt))
-    inside = curve <= 2.0 * np.mean(curve[n // 2:])
-    times = {
-        "your convergence time is in samples (time steps): give it in seconds, samples × "
-        f"Δt (Δt = {dt:g} s)": right / dt,
-        "your convergence time is in milliseconds: give it in seconds": right * 1000.0,
-        "it is the first time the curve enters the band; the definition asks for the time "
-        "after which it stays inside for good (it leaves the band again after entering it)":
-            float(np.argmax(inside)) * dt if inside.any() else None,
-        "it is the time of the last sample outside the band; the convergence time is the "
-        "sample just after it, the first that stays inside": right - dt if right > 0 else None,
-    }
-    for level, text in ((np.mean(curve), "the mean of the whole curve"),
-                        (curve[-1], "the last sample")):
-        outside = curve > 2.0 * level
-        times[f"the steady level is taken as {text}; the definition uses the mean over the "
-              f"second half of the trial"] = ((n - int(np.argmax(outside[::-1]))) * dt
-                                              if outside.any() else 0.0)
-    return times
-
-
-#: The band of the definition of a convergence time: ``factor`` × the steady level
-#: (:func:`metrics.convergence_time`'s default), and other bands a student may take.
-BAND_FACTOR = 2.0
-_OTHER_FACTORS = (1.5, 3.0, 4.0, 5.0, 10.0)
+def squared_against_readings(trial: bool = False) -> np.ndarray:
+    """Task 2's squared position errors taken against the readings instead of the truth
+    (cm²), shape (runs, 2, n): each run's own readings, or (``trial``) the one trial's y."""
+    runs = question_runs()
+    readings = runs.measurements[..., 0]          # (runs, 1, n): the same for both P0
+    return (runs.positions - (readings[0] if trial else readings)) ** 2
 
 
 @functools.cache
@@ -313,6 +288,8 @@ def _convergence() -> dict[str, object]:
     error = runs.positions - DEFAULT.truth[:, 0]
     curves = squared.mean(axis=0)
     medians = np.median(squared, axis=0)
+    readings_curves = {"each run's readings": squared_against_readings().mean(axis=0),
+                       "the one trial's readings y": squared_against_readings(True).mean(axis=0)}
     right = metrics.convergence_time(curves, dt)
     per_run = metrics.convergence_time(np.moveaxis(squared, 1, 0), dt)     # (2, runs)
     mistakes = []
@@ -340,13 +317,17 @@ def _convergence() -> dict[str, object]:
             "the curve is the filter's own variance of its position, not its actual "
             "squared error": float(metrics.convergence_time(runs.position_variances[0, index],
                                                             dt)),
+            **{f"the errors are taken against {which}, not the truth: an estimate's error is "
+               f"estimate − true position (truth[:, 0])":
+                   float(metrics.convergence_time(curve[index], dt))
+               for which, curve in readings_curves.items()},
             "the curve is the median of the squared errors over the runs; the definition "
             "uses their mean (the Monte Carlo mean)":
                 float(metrics.convergence_time(medians[index], dt)),
             **{f"the band is {factor:g} × the steady level; the definition's band is "
                f"{BAND_FACTOR:g} × (metrics.convergence_time's factor, left at its default)":
                    float(metrics.convergence_time(curves[index], dt, factor))
-               for factor in _OTHER_FACTORS},
+               for factor in OTHER_FACTORS},
         })
     return {"right": right, "mistakes": mistakes, "runs": squared.shape[0]}
 
@@ -450,6 +431,9 @@ def check_start_and_after(start_difference: metrics.Interval,
     """
     mses, burn, squared = window_mses(), DEFAULT.burn_in_steps, squared_errors()
     runs = mses["start"].shape[0]
+    against = squared_against_readings()
+    readings_mses = {"start": against[..., :burn].mean(axis=-1),
+                     "after": against[..., burn:].mean(axis=-1)}
     names = ("diag(1)'s MSE", "diag(1e5)'s MSE")
     cases = (
         ("start_difference", start_difference, "start", "after", {
@@ -488,7 +472,11 @@ def check_start_and_after(start_difference: metrics.Interval,
                            **slips,
                            "it is the difference of the root mean squared errors (cm); "
                            "the task compares the MSEs (cm²)": _paired(np.sqrt(mses_here)),
-                           **interval_mistakes(mses_here[:, 0], mses_here[:, 1], *names),
+                           **interval_mistakes(
+                               mses_here[:, 0], mses_here[:, 1], *names,
+                               readings=(readings_mses[window][:, 0],
+                                         readings_mses[window][:, 1])),
+                           **unit_mistakes(mses_here[:, 0], mses_here[:, 1], *names),
                        })
     passed(f"start_difference and after_difference match diag(1) − diag(1e5), paired over "
            f"{runs} runs, over the first {burn} samples and after them, recomputed with the "

@@ -344,63 +344,6 @@ def _unpaired(got: np.ndarray, right: np.ndarray, mean_right: bool,
                 f"{advice}")
 
 
-def _around(mean: float, half: float, runs: int) -> metrics.Interval:
-    return metrics.Interval(mean, mean - half, mean + half, runs)
-
-
-def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
-                      second_name: str) -> dict[str, metrics.Interval]:
-    """The usual mistakes of a paired difference ``first − second`` with its 95 % interval.
-
-    Parameters
-    ----------
-    first, second : ndarray, shape (runs,)
-        Per-run values of the two conditions, run r of both on the same noise.
-    first_name, second_name : str
-        What they are, for the messages ("the raw readings' MSE").
-
-    Returns
-    -------
-    dict of str to metrics.Interval
-        Cause → the interval it gives: the sign reversed, the runs treated as unpaired,
-        the two separate intervals combined, the standard deviation for the standard
-        error, 1.96 for Student's t, the population standard deviation, each condition
-        alone.
-    """
-    runs = first.size
-    difference = first - second
-    right = metrics.mean_ci95(difference)
-    t = metrics.t_critical_95(runs - 1)
-    s = float(np.std(difference, ddof=1))
-    alone_first, alone_second = metrics.mean_ci95(first), metrics.mean_ci95(second)
-    unpaired = t * np.sqrt((np.var(first, ddof=1) + np.var(second, ddof=1)) / runs)
-    both = f"{first_name} − {second_name}"
-    return {
-        f"the sign is reversed: it is {second_name} − {first_name}; the task asks for "
-        f"{both}": metrics.mean_ci95(second - first),
-        "it combines the two separate intervals. The runs are paired (the same noise in run "
-        "r), so take the interval of the per-run differences: it is much narrower because "
-        "the shared noise cancels":
-            _around(right.mean, alone_first.half_width + alone_second.half_width, runs),
-        "it treats the two as independent samples (unpaired). The runs are paired (the same "
-        "noise in run r): take the interval of the per-run differences":
-            _around(right.mean, unpaired, runs),
-        "its half-width uses the standard deviation of the differences; a 95 % interval of "
-        "the mean uses its standard error, the standard deviation divided by √runs":
-            _around(right.mean, t * s, runs),
-        f"its half-width uses the normal 1.96 instead of Student's t value for {runs - 1} "
-        f"degrees of freedom (metrics.mean_ci95 does this for you)":
-            _around(right.mean, NORMAL_95 * s / np.sqrt(runs), runs),
-        "the standard deviation is the population one (divided by runs); a sample standard "
-        "deviation divides by runs − 1":
-            _around(right.mean, t * float(np.std(difference)) / np.sqrt(runs), runs),
-        f"it is the interval of {first_name} alone, not of the per-run differences "
-        f"{both}": alone_first,
-        f"it is the interval of {second_name} alone, not of the per-run differences "
-        f"{both}": alone_second,
-    }
-
-
 def burn_in_slips(burn_in_steps: int, n: int) -> dict[str, int]:
     """The burn-in off by one sample: cause → the first sample such an MSE keeps.
 

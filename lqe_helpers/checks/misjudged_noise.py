@@ -18,7 +18,7 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import judge, judge_interval
 from .machinery import INTERVAL_RTOL, MSE_RTOL, interval_list, passed, tolerance_text
 from .noisier_proprioception import (
     BURN,
@@ -30,6 +30,7 @@ from .noisier_proprioception import (
     paired,
     sigma_grid,
 )
+from .paired_mistakes import interval_mistakes
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 

@@ -33,7 +33,7 @@ from .fusion import (
     sensor_readings,
     setup_slips,
 )
-from .judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from .judging import judge, judge_interval, mse_mistakes
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -45,6 +45,7 @@ from .machinery import (
     passed,
     tolerance_text,
 )
+from .paired_mistakes import interval_mistakes, unit_mistakes
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -332,6 +333,7 @@ def check_noisier_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
         "it is in % of the vision-only MSE; the task asks for the difference in cm²":
             metrics.mean_ci95(100 * (first - second) / first),
     }
+    mistakes.update(unit_mistakes(first, second, "the vision-only MSE", "the fused MSE"))
     judge_interval("difference", difference, paired(first, second), INTERVAL_RTOL, unit="cm²",
                    mistakes=mistakes, what="the paired difference vision-only − fused MSE "
                    "after the first second recomputed from the task's inputs")

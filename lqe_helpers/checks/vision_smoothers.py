@@ -19,7 +19,7 @@ import numpy as np
 
 from .. import metrics, smoothing
 from ..scenario import DEFAULT
-from .judging import interval_mistakes, judge, judge_interval
+from .judging import judge, judge_interval
 from .machinery import (
     FUNCTION_RTOL,
     INTERVAL_RTOL,
@@ -38,6 +38,7 @@ from .machinery import (
     tolerance_text,
 )
 from .own_work import FUNCTION_TASKS
+from .paired_mistakes import interval_mistakes
 from .vision import SIGMAS_V, keyed, monte_carlo
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback

@@ -109,9 +109,10 @@ def inside_call() -> bool:
 
 
 @machinery_function
-def reported(error: BaseException, name: str) -> StudentCodeError:
-    """The one-line StudentCodeError of :func:`call` for ``error``, raised by ``name``."""
-    return _raised(error, name, "", None, "", "", "run this cell again")
+def reported(error: BaseException, name: str, hint: str = "") -> StudentCodeError:
+    """The one-line StudentCodeError of :func:`call` for ``error``, raised by ``name``, with
+    ``hint`` (what to do) after it."""
+    return _raised(error, name, "", None, hint, "", "run this cell again")
 
 
 def _working_folder() -> str | None:

@@ -124,14 +124,14 @@ GUARDS: dict[str, Callable[..., str | None]] = {
 }
 
 
-def guarded(name: str, function: Callable) -> Callable:
+def guarded(name: str, function: Callable, hint: str = "") -> Callable:
     """``function`` with the inputs guard of ``name`` (:data:`GUARDS`), if it has one.
 
     The wrapper calls the student's function unchanged when the inputs fit; otherwise it
     raises :class:`StudentCodeError`: "my_filter was given R of shape (2, 2); …". Called
     from a notebook cell (not through :func:`~lqe_helpers.student_code.call`), an error of
     the function is reported the same way, as one line and the student's own frames (not
-    this wrapper's source).
+    this wrapper's source), with ``hint``: where to fix it.
     """
     guard = GUARDS.get(name)
     if guard is None:
@@ -150,6 +150,6 @@ def guarded(name: str, function: Callable) -> Callable:
         try:
             return function(*args, **kwargs)
         except Exception as error:  # called from the student's cell: their lines, one line
-            raise calling.reported(error, name) from None
+            raise calling.reported(error, name, hint) from None
 
     return checked

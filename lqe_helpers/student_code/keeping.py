@@ -253,7 +253,10 @@ def load(name: str, folder: str | os.PathLike | None = None) -> Callable:
     function = namespace.get(name)
     if not isinstance(function, types.FunctionType):
         raise StudentCodeError(f"{shown} does not define a function {name}")
-    return recorded(name, guarded(name, function))
+    fix = (f"This {name} is yours, saved by {SAVED_BY[name]}: fix it there, run that check "
+           f"again (it saves {name} anew), then restart this notebook's kernel and run it from "
+           f"the top" if name in SAVED_BY else "")
+    return recorded(name, guarded(name, function, fix))
 
 
 def _not_saved_yet(name: str, message: str) -> Callable:

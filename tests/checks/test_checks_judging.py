@@ -8,8 +8,9 @@ from check_outcomes import assert_fails
 
 from lqe_helpers import checks, metrics
 from lqe_helpers.checks import CheckFailed
-from lqe_helpers.checks.judging import interval_mistakes, judge, judge_interval, mse_mistakes
+from lqe_helpers.checks.judging import judge, judge_interval, mse_mistakes
 from lqe_helpers.checks.machinery import argument_array, positive_number
+from lqe_helpers.checks.paired_mistakes import interval_mistakes
 from lqe_helpers.student_code import OwnCodeTraceback
 
 

@@ -158,7 +158,9 @@ def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     assert name == "StudentCodeError"
     assert shown.rstrip().endswith(
         "StudentCodeError: my_filter raised ZeroDivisionError: division by zero (in "
-        "my_filter, line 6 of my_filter.py: `gain = 1 / 0`).")
+        "my_filter, line 6 of my_filter.py: `gain = 1 / 0`). This my_filter is yours, saved by "
+        "notebook 01 (the check after Task 1): fix it there, run that check again (it saves "
+        "my_filter anew), then restart this notebook's kernel and run it from the top")
     assert "----> 6         gain = 1 / 0" in shown and "guards" not in shown
     assert_only_the_students_code(shown)
     # numpy's "assignment destination is read-only" names the array and how to copy it.
