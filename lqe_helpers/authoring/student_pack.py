@@ -6,9 +6,9 @@
 
 - ``notebooks/``: the student edition of every notebook (tasks as stubs, answers as
   prompts; built as ``make student`` builds it, and refused for the same reasons);
-- ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/``. Those are the
-  instructor's tools (run notebooks, build handouts, the student edition, this pack,
-  the marking guide); nothing a student runs (notebooks, explorers, checks, ``make lab``,
+- ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/`` and
+  ``lqe_helpers/grading/``. Those are the instructor's tools (run notebooks, build
+  handouts, the student edition, this pack, the marking guide, grading); nothing a student runs (notebooks, explorers, checks, ``make lab``,
   ``make test``) imports them, and leaving them out keeps the pack to what students use;
 - ``README.md``: the students' own (:data:`STUDENT_README`: what to run, how to work a
   notebook, where help is), not the course's, which speaks to instructors and
@@ -64,7 +64,7 @@ TOP_FILES = ("pyproject.toml", "constraints.txt")
 #: Folders of the course folder the pack copies from; its output folder may not overlap them.
 SOURCES = ("notebooks", "lqe_helpers", "tests")
 #: Sub-packages of lqe_helpers that stay with the instructor.
-INSTRUCTOR_PACKAGES = ("authoring",)
+INSTRUCTOR_PACKAGES = ("authoring", "grading")
 #: The only files of tests/ the pack ships (every other one stays with the instructor):
 #: tests of the pack's infrastructure that hold no worked answer and no task's result.
 PACK_TESTS = ("conftest.py", "test_validation.py", "test_public_errors.py",
@@ -282,8 +282,8 @@ after every core task, and that its imports resolve. The checks inside the noteb
 whether your code is right: run a task, then the check cell below it.
 
 Left out of this pack, for the instructor: the worked notebooks, the marking guide, the
-authoring tools (`lqe_helpers/authoring/`) and every test that is not about this
-installation. `README.md` says how to work through the notebooks.
+authoring and grading tools (`lqe_helpers/authoring/`, `lqe_helpers/grading/`) and every
+test that is not about this installation. `README.md` says how to work through the notebooks.
 """
 
 

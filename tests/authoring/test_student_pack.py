@@ -110,7 +110,7 @@ def test_pack_makefile_refuses_a_makefile_it_cannot_keep_lab_from(text, message)
 #: What no test shipped to students may import or read: the oracle loops, the checks'
 #: worked and wrong answers, the instructor's tools, the worked notebooks, the suite's
 #: shared builds.
-INSTRUCTOR_ONLY = re.compile(r"reference_loops|check_outcomes|lqe_helpers\.authoring"
+INSTRUCTOR_ONLY = re.compile(r"reference_loops|check_outcomes|lqe_helpers\.(authoring|grading)"
                              r"|from lqe_helpers import authoring|[\"']notebooks[\"']"
                              r"|(?:from|import) (?:artefacts|once_per_run|make_env)\b"
                              r"|[\"']artefacts[\"']")
@@ -150,7 +150,8 @@ def test_the_pack_holds_what_a_student_needs_and_nothing_of_the_instructor(pack)
                    "lqe_helpers/explorers/__init__.py", "tests/conftest.py",
                    f"tests/{sp.STRUCTURE_TEST}", f"tests/{sp.CONVENTIONS_NAME}"):
         assert needed in inside, needed
-    assert not [name for name in inside if name.startswith("lqe_helpers/authoring")]
+    assert not [name for name in inside if name.startswith(("lqe_helpers/authoring",
+                                                            "lqe_helpers/grading"))]
     assert not [name for name in inside if "__pycache__" in name or name.endswith(".pyc")]
     assert not [name for name in inside if "marking" in name]
     assert {name for name in inside if name.startswith("tests/")} == {
