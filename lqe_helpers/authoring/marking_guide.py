@@ -37,9 +37,9 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
-    from lqe_helpers.authoring.points import graded_cells
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
+    from lqe_helpers.authoring.points import graded_cells
     from lqe_helpers.authoring.task_cells import (
         ANSWER_TAG,
         CHECK_CALL,

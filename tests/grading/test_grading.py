@@ -13,10 +13,10 @@ import pytest
 from grading_submissions import NAME, WORKED, WRONG_FILTER, edition, endless_loop, raises_first
 
 from lqe_helpers.authoring import points
-from lqe_helpers.grading import grade, nbgrader_course, rules
 from lqe_helpers.authoring.marking_guide import QUESTION_MARKS, question_and_marks
 from lqe_helpers.authoring.student_edition import student_edition
 from lqe_helpers.authoring.task_cells import stub_source
+from lqe_helpers.grading import grade, nbgrader_course, rules
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[2] / "notebooks").glob("*.ipynb"))
 
