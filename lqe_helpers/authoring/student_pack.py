@@ -9,7 +9,8 @@
 - ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/`` and
   ``lqe_helpers/grading/``. Those are the instructor's tools (run notebooks, build
   handouts, the student edition, this pack, the marking guide, grading); nothing a
-  student runs (notebooks, explorers, checks, ``make lab``, ``make test``) imports them, and leaving them out keeps the pack to what students use;
+  student runs (notebooks, explorers, checks, ``make lab``, ``make test``) imports
+  them, and leaving them out keeps the pack to what students use;
 - ``README.md``: the students' own (:data:`STUDENT_README`: what to run, how to work a
   notebook, where help is), not the course's, which speaks to instructors and
   maintainers; ``pyproject.toml``, ``constraints.txt``;
