@@ -9,7 +9,7 @@
     build/handouts/prose/NN_name.html  prose, printed results and figures only
 
 Each notebook is executed once, in a fresh kernel, by
-:func:`lqe_helpers.authoring.notebook_runner.execute_notebook`. A notebook that raises, shows an
+:func:`lqe_helpers.authoring.execution.execute_notebook`. A notebook that raises, shows an
 error output, or displays a widget with no static view (which a page could only show
 as a placeholder) stops the build, and the message names the notebook and the cell
 (and gives the traceback); output on stderr (a warning) is reported but kept. A cell

@@ -26,12 +26,10 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from collections.abc import Sequence
     from pathlib import Path
 
-    from lqe_helpers.authoring.command_line import CommandLineParser, fail, run_command
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import NotebookFileError, shown, summarise
     from lqe_helpers.authoring.execution import (
         CELL_TIMEOUT,
-        WIDGET_VIEW_MIMETYPE,
-        NotebookRunError,
         execute_notebook,
         positive_seconds,
     )
@@ -42,9 +40,6 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         parse_notebook,
         read_notebook_bytes,
     )
-
-__all__ = ["CELL_TIMEOUT", "TOOL_NAME", "WIDGET_VIEW_MIMETYPE", "NotebookRunError",
-           "execute_notebook", "fail", "main", "positive_seconds", "run_notebooks"]
 
 #: The name the runner records in the journal of a save.
 TOOL_NAME = "notebook_runner"

@@ -47,6 +47,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from pathlib import Path
 
     from lqe_helpers.authoring import student_edition as se
+    from lqe_helpers.authoring import task_cells as tc
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
@@ -246,9 +247,9 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
         files[f"tests/{name}"] = _read_text(path).encode()  # non-UTF-8 text stops it, named
     files[f"tests/{STRUCTURE_TEST}"] = (PACK_FILES / STRUCTURE_TEST).read_bytes()
     conventions = {
-        "tags": sorted(se.STUDENT_TAGS), "task_tag": se.TASK_TAG,
-        "task_prefix": se.TASK_PREFIX, "check_call": se.CHECK_CALL,
-        "going_further": se.GOING_FURTHER, "notebooks": names,
+        "tags": sorted(se.STUDENT_TAGS), "task_tag": tc.TASK_TAG,
+        "task_prefix": tc.TASK_PREFIX, "check_call": tc.CHECK_CALL,
+        "going_further": tc.GOING_FURTHER, "notebooks": names,
         "checked_notebooks": [name for name in names if name.startswith(CHECKED_PREFIXES)],
     }
     files[f"tests/{CONVENTIONS_NAME}"] = (json.dumps(conventions, indent=1) + "\n").encode()
