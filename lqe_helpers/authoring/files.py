@@ -31,8 +31,9 @@ def refuse_symlink(path: Path | str) -> None:
     """Raise :class:`FileSafetyError` if ``path`` is a symbolic link (dangling or not)."""
     if os.path.islink(path):
         raise FileSafetyError(
-            f"{path} is a symbolic link (to {os.readlink(path)}); the tools never write "
-            f"through a link nor replace one: remove the link or write elsewhere")
+            f"{path} is a symbolic link (to {os.readlink(path)}); the tools never read or write "
+            f"through a link (it could lead to any file) nor replace one: put the file itself "
+            f"there, remove the link or write elsewhere")
 
 
 def _write_fd(fd: int, data: bytes) -> None:

@@ -72,7 +72,6 @@ def _check_paths(paths: Sequence[Path]) -> dict[Path, FileState]:
 
 
 def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
-                  kernel_name: str = "python3",
                   log: bool = True) -> tuple[list[Path], list[Path]]:
     """Execute each notebook and save it in place, all or none.
 
@@ -90,8 +89,6 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
         The notebooks (``.ipynb`` files; not symbolic links).
     timeout : float
         Seconds one cell may run.
-    kernel_name : str
-        Kernel to start for each notebook.
     log : bool
         Print ``executing <path>`` before each run.
 
@@ -121,7 +118,7 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
         for path, state in checked.items():
             if log:
                 print(f"executing {shown(path)}", flush=True)
-            content = notebook_bytes(execute_notebook(path, timeout, kernel_name))
+            content = notebook_bytes(execute_notebook(path, timeout))
             if file_state(path) != state:
                 results[path] = content  # changed meanwhile: the save below keeps it
             elif path.read_bytes() != content:

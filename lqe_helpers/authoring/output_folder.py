@@ -36,7 +36,7 @@ from lqe_helpers.authoring.manifest import (
     name_problem,
     read_manifest,
 )
-from lqe_helpers.authoring.swap import swap_in
+from lqe_helpers.authoring.swap import swap_folders
 
 
 def _ancestors(path: Path) -> list[Path]:
@@ -253,7 +253,7 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
     checks it (:func:`plan_output_folder`): a file in the way that the tool did not
     write, or changed since, stops the build before anything is written. Then the files
     and the manifest are swapped in and the files of an earlier build no longer written
-    deleted (:func:`~lqe_helpers.authoring.swap.swap_in`, all or nothing).
+    deleted (:func:`~lqe_helpers.authoring.swap.swap_folders`, all or nothing).
 
     Parameters
     ----------
@@ -309,9 +309,10 @@ def build_output_folder(out_dir: Path | str, names: Sequence[str],
                 manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
                 expected = {**{name: None for name in plan.create},
                             **{name: plan.ours[name] for name in plan.replace}}
-                swap_in(out_dir, {**contents, MANIFEST_NAME: manifest.to_bytes()},
-                        {name: plan.ours[name] for name in plan.delete}, tool=tool,
-                        expected=expected)
+                writes = {**contents, MANIFEST_NAME: manifest.to_bytes()}
+                deletes = {name: plan.ours[name] for name in plan.delete}
+                swap_folders({out_dir: (writes, deletes, expected, {})}, tool, shown(out_dir),
+                             strict=True)
         except OSError as error:
             where = f" ({shown(error.filename)})" if error.filename else ""
             raise OutputWriteError(

@@ -50,6 +50,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring import task_cells as tc
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.files import refuse_symlink
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
 
@@ -147,13 +148,6 @@ def source_folders(root: Path) -> list[Path]:
     return [Path(root) / name for name in SOURCES]
 
 
-def _refuse_link(path: Path) -> None:
-    if path.is_symlink():
-        raise ValueError(f"{shown(path)} is a symbolic link; the student pack copies only real "
-                         f"files (a link could bring in any file, the marking guide say): "
-                         f"put the file itself there, or remove the link")
-
-
 def _files_under(folder: Path) -> list[Path]:
     """Every regular file under ``folder``, sorted; ``__pycache__``, ``.pyc`` and ``.pyo`` left out.
 
@@ -163,12 +157,12 @@ def _files_under(folder: Path) -> list[Path]:
         Naming the first symbolic link, or the first entry that is neither a file nor a
         folder (a fifo, a device, a socket), found in ``folder``.
     """
-    _refuse_link(folder)
+    refuse_symlink(folder)
     found = []
     for path in sorted(folder.rglob("*")):
         if "__pycache__" in path.relative_to(folder).parts:
             continue
-        _refuse_link(path)
+        refuse_symlink(path)
         if path.is_dir():
             continue
         if not path.is_file():
@@ -181,18 +175,13 @@ def _files_under(folder: Path) -> list[Path]:
 
 def _read_text(path: Path) -> str:
     """The UTF-8 text of the file ``path`` (not a link); a failure names the file."""
-    _refuse_link(path)
+    refuse_symlink(path)
     data = path.read_bytes()
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
         raise ValueError(f"{shown(path)} is not UTF-8 text ({error.reason} at byte "
                          f"{error.start}); save it as UTF-8") from None
-
-
-def _read_bytes(path: Path) -> bytes:
-    _refuse_link(path)
-    return path.read_bytes()
 
 
 def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[str, bytes]:
@@ -239,7 +228,7 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
             files[f"lqe_helpers/{relative.as_posix()}"] = path.read_bytes()
     for name in PACK_TESTS:
         path = root / "tests" / name
-        _refuse_link(path)
+        refuse_symlink(path)
         if not path.is_file():
             raise ValueError(f"{shown(path)} is not a regular file (a fifo, a device or a "
                              f"folder); the student pack copies only files: put the test "
@@ -256,7 +245,7 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     files["Makefile"] = pack_makefile(_read_text(root / "Makefile")).encode()
     files["README.md"] = _read_text(PACK_FILES / STUDENT_README).encode()
     for name in TOP_FILES:
-        files[name] = _read_bytes(root / name)
+        files[name] = _read_text(root / name).encode()
     files[MARKER_NAME] = marker_text().encode()
     for name in files:  # a zip names its files in UTF-8
         if name.encode("utf-8", "replace").decode("utf-8") != name:
