@@ -59,21 +59,6 @@ def mode_for(path: Path) -> int:
         return new_file_mode()
 
 
-def _write_all(fd: int, data: bytes, path: Path) -> None:
-    """Write ``data`` to ``fd`` and flush it to disk; a failure names ``path``.
-
-    ``os.write`` reports a full disk (ENOSPC) or a file-size limit (EFBIG, ``ulimit -f``)
-    without a file name; the error raised here carries ``path``.
-    """
-    try:
-        _write_fd(fd, data)
-        os.fsync(fd)
-    except OSError as error:
-        if error.filename is None and error.errno is not None:
-            raise OSError(error.errno, error.strerror, str(path)) from error
-        raise
-
-
 def check_target(path: Path) -> None:
     """Refuse a write target that is a link or a folder (:class:`FileSafetyError`)."""
     refuse_symlink(path)
@@ -158,7 +143,13 @@ def write_new_file(path: Path, data: bytes, *, mode: int | None = None,
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, new_file_mode())
     try:
         os.fchmod(fd, new_file_mode() if mode is None else mode)
-        _write_all(fd, data, path if named is None else named)
+        _write_fd(fd, data)
+        os.fsync(fd)
+    except OSError as error:  # os.write names no file (ENOSPC, EFBIG: ``ulimit -f``)
+        if error.filename is None and error.errno is not None:
+            raise OSError(error.errno, error.strerror,
+                          str(path if named is None else named)) from error
+        raise
     finally:
         os.close(fd)
 

@@ -60,7 +60,8 @@ TOOL_NAME = "student_pack"
 PACK_NAME = "lqe-student-pack"
 #: The zip written in the output folder.
 ZIP_NAME = f"{PACK_NAME}.zip"
-#: What the pack is, at its top level (also marks an unpacked folder as a student pack).
+#: What the pack is, at its top level (also marks an unpacked folder as a student pack);
+#: its text is the file of that name in :data:`PACK_FILES`.
 MARKER_NAME = "STUDENT-PACK.md"
 #: Files copied from the top of the course folder as they are.
 TOP_FILES = ("pyproject.toml", "constraints.txt")
@@ -246,36 +247,12 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
     files["README.md"] = _read_text(PACK_FILES / STUDENT_README).encode()
     for name in TOP_FILES:
         files[name] = _read_text(root / name).encode()
-    files[MARKER_NAME] = marker_text().encode()
+    files[MARKER_NAME] = _read_text(PACK_FILES / MARKER_NAME).encode()
     for name in files:  # a zip names its files in UTF-8
         if name.encode("utf-8", "replace").decode("utf-8") != name:
             raise ValueError(f"{shown(root / name)}: its name is not UTF-8; the student pack "
                              f"(a zip) names its files in UTF-8: rename it")
     return dict(sorted(files.items()))
-
-
-def marker_text() -> str:
-    """The text of :data:`MARKER_NAME`."""
-    return """# The LQE course pack: student pack
-
-This folder is the course pack for students. The notebooks in `notebooks/` are the
-student edition: every cell that starts with `# Task:` is yours to write, and every
-**Your answer** cell yours to fill in.
-
-```bash
-make lab     # first run: creates .venv, installs everything, opens JupyterLab on notebooks/
-make test    # checks the installation and the structure of the notebooks
-```
-
-`make test` here does not run the notebooks (your unfinished tasks would stop it by design);
-it checks that each notebook is valid, carries only the student edition's tags, has a check
-after every core task, and that its imports resolve. The checks inside the notebooks tell you
-whether your code is right: run a task, then the check cell below it.
-
-Left out of this pack, for the instructor: the worked notebooks, the marking guide, the
-authoring and grading tools (`lqe_helpers/authoring/`, `lqe_helpers/grading/`) and every
-test that is not about this installation. `README.md` says how to work through the notebooks.
-"""
 
 
 def zip_bytes(files: dict[str, bytes]) -> bytes:
