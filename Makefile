@@ -105,7 +105,7 @@ student-pack: $(STAMP)
 # nbgrader cell metadata and points) and nbgrader_config.py. Run nbgrader there (pip install
 # -e '.[grading]'); see docs/instructors.md, "Grading a class".
 nbgrader: $(STAMP)
-	$(BIN)/python -m lqe_helpers.authoring.nbgrader_course --source notebooks --out build/nbgrader
+	$(BIN)/python -m lqe_helpers.grading.nbgrader_course --source notebooks --out build/nbgrader
 
 # Speed against a peer in the same process (ratios, not pass/fail): filter and sliders.
 bench: $(STAMP)

@@ -31,7 +31,7 @@ from grading_submissions import (
     wrong_science,
 )
 
-from lqe_helpers.authoring.grade import grade_all
+from lqe_helpers.grading.grade import grade_all
 
 #: The kinds of submission, in turn, with the automatic points each must get.
 KINDS = (("worked", lambda: WORKED.read_text(encoding="utf-8"), "9"),

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import nbformat
 
-from lqe_helpers.authoring.notebook_runner import execute_notebook
+from lqe_helpers.authoring.execution import execute_notebook
 
 NOTEBOOK_DIR = Path(__file__).resolve().parent.parent / "notebooks"
 QUESTION_PREFIXES = ("01", "02", "03", "04", "05")

@@ -52,6 +52,7 @@ from once_per_run import Build, SharedArtefacts
 
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
+from lqe_helpers.authoring import task_cells as tc
 from lqe_helpers.authoring.handouts import build_handouts
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -158,7 +159,7 @@ def core_end(notebook: nbformat.NotebookNode) -> int:
     """Index of the ``## Going further`` heading cell (the end of the core path)."""
     return next((index for index, cell in enumerate(notebook.cells)
                  if cell.cell_type == "markdown"
-                 and cell.source.lstrip().startswith(se.GOING_FURTHER)), len(notebook.cells))
+                 and cell.source.lstrip().startswith(tc.GOING_FURTHER)), len(notebook.cells))
 
 
 def filled_core(source: nbformat.NotebookNode,
@@ -180,9 +181,9 @@ def filled_core(source: nbformat.NotebookNode,
     """
     filled = nbformat.from_dict(json.loads(json.dumps(student)))
     solutions = [cell for cell in source.cells
-                 if se.SOLUTION_TAG in cell.get("metadata", {}).get("tags", [])]
+                 if tc.SOLUTION_TAG in cell.get("metadata", {}).get("tags", [])]
     stubs = [cell for cell in filled.cells
-             if se.TASK_TAG in cell.get("metadata", {}).get("tags", [])]
+             if tc.TASK_TAG in cell.get("metadata", {}).get("tags", [])]
     assert len(stubs) == len(solutions), f"{len(stubs)} tasks for {len(solutions)} solutions"
     for stub, solution in zip(stubs, solutions, strict=True):
         assert stub.source.splitlines()[0] == solution.source.splitlines()[0]

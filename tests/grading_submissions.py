@@ -1,7 +1,7 @@
 """Simulated submissions of notebook 01 (and of 02–05 for the whole assignment), made from
 the worked notebooks and their student editions or nbgrader's release.
 
-Used by the grading tests (tests/authoring/test_grading*.py) and benchmarks/bench_grading.py. Each
+Used by the grading tests (tests/grading/test_grading*.py) and benchmarks/bench_grading.py. Each
 maker returns the text of an ``.ipynb`` file (or raw bytes for the broken ones).
 """
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import nbformat
 
-from lqe_helpers.authoring.grading import core_end
+from lqe_helpers.authoring.points import core_end
 from lqe_helpers.authoring.student_edition import student_edition
 from lqe_helpers.authoring.task_cells import SOLUTION_TAG, TASK_TAG, cell_tags
 

@@ -9,7 +9,8 @@ Layers, bottom to top (issue 18):
 * experiments: ``experiments`` and ``bias_model``, whose results may draw themselves
   through ``figures``, and ``jerk_tuning``, which runs experiments;
 * explorers and checks, side by side: neither imports the other;
-* authoring: the instructor's tools, which nothing imports.
+* authoring: the instructor's tools, which nothing imports but grading;
+* grading: grading a class, built on authoring, which nothing imports.
 
 A module may import its own layer and the layers below it. A private module (``_x``)
 may be imported only by modules inside its own package (its subpackages too), and no
@@ -24,7 +25,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "lqe_helpers"
-LAYERS = ("science", "drawing", "experiments", "explorers", "checks", "authoring")
+LAYERS = ("science", "drawing", "experiments", "explorers", "checks", "authoring", "grading")
 #: The layers each layer may import.
 ALLOWED = {
     "science": {"science"},
@@ -32,7 +33,8 @@ ALLOWED = {
     "experiments": {"science", "drawing", "experiments"},
     "explorers": {"science", "drawing", "experiments", "explorers"},
     "checks": {"science", "drawing", "experiments", "checks"},
-    "authoring": set(LAYERS),
+    "authoring": set(LAYERS) - {"grading"},
+    "grading": set(LAYERS),
 }
 #: Longest module allowed (lines), in every layer (the instructor's tools too).
 MAX_LINES = 500
@@ -46,7 +48,7 @@ def layer_of(module: str) -> str:
         return "drawing"
     if top in ("experiments", "bias_model", "jerk_tuning"):
         return "experiments"
-    if top in ("explorers", "checks", "authoring"):
+    if top in ("explorers", "checks", "authoring", "grading"):
         return top
     return "science"
 
@@ -211,6 +213,8 @@ def test_figures_mirror_the_explorers() -> None:
      "imports the private name _one_run of lqe_helpers.experiments"),
     ("lqe_helpers.checks._filter", "import lqe_helpers.authoring.files",
      "(checks) imports lqe_helpers.authoring.files (authoring)"),
+    ("lqe_helpers.authoring.marking_guide", "from lqe_helpers.grading import rules",
+     "(authoring) imports lqe_helpers.grading.rules (grading)"),
     # Yesterday's smoothing.py: a private function of another module, as an attribute.
     ("lqe_helpers.smoothing", "from . import validation\nreason = validation._not_real(w)",
      "uses the private name _not_real of lqe_helpers.validation"),
@@ -235,6 +239,7 @@ def test_the_rules_allow_what_the_layers_need() -> None:
         ("lqe_helpers.checks._filter",
          "from ._common import CheckFailed\nfrom .. import reference"),
         ("lqe_helpers.authoring.marking_guide", "from lqe_helpers import checks"),
+        ("lqe_helpers.grading.grade", "from lqe_helpers.authoring.points import core_end"),
         # A private module of its own package, its public names; dunders; other objects.
         ("lqe_helpers.experiments", "from . import _engine\n_engine.filter_run(y)"),
         ("lqe_helpers.experiments", "from . import figures\nfigures.__name__"),

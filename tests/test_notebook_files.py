@@ -20,6 +20,7 @@ import nbformat
 import pytest
 
 from lqe_helpers.authoring import student_edition as se
+from lqe_helpers.authoring import task_cells as tc
 from lqe_helpers.authoring.marking_guide import QUESTION_MARKS
 
 NOTEBOOK_DIR = Path(__file__).resolve().parent.parent / "notebooks"
@@ -103,14 +104,14 @@ def test_only_explorer_cells_skip_output_comparison(path):
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_worked_answers_are_marked(path):
     notebook = nbformat.read(path, as_version=4)
-    solutions = [cell for cell in notebook.cells if se.SOLUTION_TAG in tags(cell)]
-    answers = [cell for cell in notebook.cells if se.ANSWER_TAG in tags(cell)]
+    solutions = [cell for cell in notebook.cells if tc.SOLUTION_TAG in tags(cell)]
+    answers = [cell for cell in notebook.cells if tc.ANSWER_TAG in tags(cell)]
     assert solutions, f"{path.name} marks no solution cell: the student edition would leak"
     assert answers, f"{path.name} marks no written answer"
     for cell in solutions:
         assert cell.cell_type == "code"
-        assert cell.source.startswith(se.TASK_PREFIX), (
-            f"{path.name}: a solution cell does not start with {se.TASK_PREFIX!r}: "
+        assert cell.source.startswith(tc.TASK_PREFIX), (
+            f"{path.name}: a solution cell does not start with {tc.TASK_PREFIX!r}: "
             f"{cell.source[:60]!r}")
     assert all(cell.cell_type == "markdown" for cell in answers)
 
@@ -119,7 +120,7 @@ def test_worked_answers_are_marked(path):
 def test_only_known_tags_and_the_student_edition_builds(path):
     notebook = nbformat.read(path, as_version=4)
     for index, cell in enumerate(notebook.cells):
-        unknown = set(tags(cell)) - se.ALLOWED_TAGS
+        unknown = set(tags(cell)) - tc.ALLOWED_TAGS
         assert not unknown, f"{path.name}, cell {index}: unknown tags {sorted(unknown)}"
     se.student_edition(notebook, path.stem)  # raises, naming the cell, on a broken convention
 
@@ -152,19 +153,19 @@ def core_end(notebook: nbformat.NotebookNode) -> int:
     """Index of the ``## Going further`` cell (the end of the core path), or -1."""
     return next((index for index, cell in enumerate(notebook.cells)
                  if cell.cell_type == "markdown"
-                 and cell.source.lstrip().startswith(se.GOING_FURTHER)), -1)
+                 and cell.source.lstrip().startswith(tc.GOING_FURTHER)), -1)
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_a_short_core_path_then_going_further(path):
     notebook = nbformat.read(path, as_version=4)
     end = core_end(notebook)
-    assert end > 0, f"{path.name} has no markdown cell starting {se.GOING_FURTHER!r}"
+    assert end > 0, f"{path.name} has no markdown cell starting {tc.GOING_FURTHER!r}"
     words = sum(len(cell.source.split()) for cell in notebook.cells[:end]
                 if cell.cell_type == "markdown")
     assert words <= CORE_WORDS, f"{path.name}: {words} words of markdown before Going further"
     headings = [cell for cell in notebook.cells
-                if cell.cell_type == "markdown" and se.GOING_FURTHER in cell.source]
+                if cell.cell_type == "markdown" and tc.GOING_FURTHER in cell.source]
     assert len(headings) == 1, f"{path.name}: {len(headings)} Going further headings"
 
 
@@ -172,12 +173,12 @@ def test_a_short_core_path_then_going_further(path):
 def test_a_check_right_after_every_core_task(path):
     notebook = nbformat.read(path, as_version=4)
     cells, end = notebook.cells, core_end(notebook)
-    assert end > 0, f"{path.name} has no markdown cell starting {se.GOING_FURTHER!r}"
-    tasks = [index for index, cell in enumerate(cells[:end]) if se.SOLUTION_TAG in tags(cell)]
+    assert end > 0, f"{path.name} has no markdown cell starting {tc.GOING_FURTHER!r}"
+    tasks = [index for index, cell in enumerate(cells[:end]) if tc.SOLUTION_TAG in tags(cell)]
     assert tasks, f"{path.name}: no task in the core path"
     for index in tasks:
         after = cells[index + 1] if index + 1 < len(cells) else None
-        place = se.cell_place(path.name, index, cells[index])
+        place = tc.cell_place(path.name, index, cells[index])
         assert after is not None and after.cell_type == "code" and not tags(after), (
             f"{place}: the next cell must be an untagged code cell with its check")
         calls = re.findall(r"\bchecks\.check_\w+\s*\(", after.source)
@@ -189,7 +190,7 @@ def test_a_check_right_after_every_core_task(path):
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_every_figure_is_shown_with_its_description(path):
     for index, cell in enumerate(nbformat.read(path, as_version=4).cells):
-        if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+        if cell.cell_type != "code" or tc.EXPLORER_TAG in tags(cell):
             continue
         place = f"{path.name}, cell {index}"
         assert not BARE_SHOW.search(cell.source), (

@@ -47,12 +47,6 @@ class CommandLineParser(argparse.ArgumentParser):
         raise SystemExit(1)
 
 
-def fail(message: object) -> int:
-    """Print ``error: <message>`` (its first line) on stderr; return 1 (a failed command)."""
-    print(f"error: {first_line(str(message)) or message}", file=sys.stderr)
-    return 1
-
-
 def _one_line_warning(message: Warning | str, category: type[Warning], filename: str,
                       lineno: int, file: Any = None, line: str | None = None) -> None:
     print(f"warning: {first_line(str(message))}", file=sys.stderr if file is None else file)

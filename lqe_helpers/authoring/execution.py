@@ -159,10 +159,9 @@ def _run_error(error: BaseException, path: Path, cell: str, timeout: float,
         [f"The kernel's own output:\n{log}"] if log else [])]))
 
 
-def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
-                     kernel_name: str = "python3", *,
+def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT, *,
                      allow_errors: bool = False) -> nbformat.NotebookNode:
-    """Run every cell of the notebook at ``path`` in a new kernel; return the result.
+    """Run every cell of the notebook at ``path`` in a new ``python3`` kernel; return it.
 
     Widget state is not stored (it would break across ipywidgets versions), timings
     are not recorded, the pieces of each stream (stdout, stderr) are merged into one
@@ -175,8 +174,6 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
         The notebook (read only; the result is returned, not written).
     timeout : float
         Seconds one cell may run (> 0).
-    kernel_name : str
-        Kernel to start.
     allow_errors : bool
         Keep going after a cell raises: its error (with the traceback) is left in
         that cell's outputs. By default the first error stops the run.
@@ -203,7 +200,7 @@ def execute_notebook(path: Path | str, timeout: float = CELL_TIMEOUT,
         running[:] = [cell_index, time.monotonic()]
 
     client = NotebookClient(
-        notebook, timeout=timeout, kernel_name=kernel_name, on_cell_start=cell_started,
+        notebook, timeout=timeout, kernel_name="python3", on_cell_start=cell_started,
         resources={"metadata": {"path": str(path.parent.resolve())}},
         store_widget_state=False, record_timing=False, allow_errors=allow_errors,
         coalesce_streams=False)  # merged afterwards, in linear time (merge_streams)

@@ -31,8 +31,9 @@ def refuse_symlink(path: Path | str) -> None:
     """Raise :class:`FileSafetyError` if ``path`` is a symbolic link (dangling or not)."""
     if os.path.islink(path):
         raise FileSafetyError(
-            f"{path} is a symbolic link (to {os.readlink(path)}); the tools never write "
-            f"through a link nor replace one: remove the link or write elsewhere")
+            f"{path} is a symbolic link (to {os.readlink(path)}); the tools never read or write "
+            f"through a link (it could lead to any file) nor replace one: put the file itself "
+            f"there, remove the link or write elsewhere")
 
 
 def _write_fd(fd: int, data: bytes) -> None:
@@ -56,21 +57,6 @@ def mode_for(path: Path) -> int:
         return stat.S_IMODE(os.stat(path, follow_symlinks=False).st_mode)
     except FileNotFoundError:
         return new_file_mode()
-
-
-def _write_all(fd: int, data: bytes, path: Path) -> None:
-    """Write ``data`` to ``fd`` and flush it to disk; a failure names ``path``.
-
-    ``os.write`` reports a full disk (ENOSPC) or a file-size limit (EFBIG, ``ulimit -f``)
-    without a file name; the error raised here carries ``path``.
-    """
-    try:
-        _write_fd(fd, data)
-        os.fsync(fd)
-    except OSError as error:
-        if error.filename is None and error.errno is not None:
-            raise OSError(error.errno, error.strerror, str(path)) from error
-        raise
 
 
 def check_target(path: Path) -> None:
@@ -157,7 +143,13 @@ def write_new_file(path: Path, data: bytes, *, mode: int | None = None,
     fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, new_file_mode())
     try:
         os.fchmod(fd, new_file_mode() if mode is None else mode)
-        _write_all(fd, data, path if named is None else named)
+        _write_fd(fd, data)
+        os.fsync(fd)
+    except OSError as error:  # os.write names no file (ENOSPC, EFBIG: ``ulimit -f``)
+        if error.filename is None and error.errno is not None:
+            raise OSError(error.errno, error.strerror,
+                          str(path if named is None else named)) from error
+        raise
     finally:
         os.close(fd)
 

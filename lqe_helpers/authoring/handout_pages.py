@@ -16,8 +16,9 @@ copied (:data:`MATHJAX_PARTS`).
 
 Figures: a figure shown with :func:`lqe_helpers.plotting.show_figure` arrives as an
 ``<img>`` whose ``alt`` is its description (``text/html``, preferred) and as ``image/png``
-with the description in ``metadata["image/png"]["alt"]``, which the template here writes
-into the ``alt`` attribute (nbconvert's lab template drops it). A PNG output with no
+with the description in ``metadata["image/png"]["alt"]``, which the page's template
+(``handout_template/lqe_handout.html.j2``, with its CSS and MathJax configuration beside
+it) writes into the ``alt`` attribute (nbconvert's lab template drops it). A PNG output with no
 description gets nbconvert's :data:`GENERIC_ALT`, which the browser audit refuses;
 :func:`undescribed_figures` lists such figures for the build to report.
 
@@ -37,7 +38,6 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import nbformat
-from jinja2 import DictLoader
 from nbconvert.exporters import HTMLExporter
 from nbconvert.preprocessors import Preprocessor
 from PIL import Image, UnidentifiedImageError
@@ -83,170 +83,10 @@ GENERIC_ALT = "No description has been provided for this image"
 #: The mimetypes a figure arrives as, and whose description (``alt``) a page needs.
 FIGURE_MIMETYPES = ("image/png", "image/jpeg")
 
+#: The handout page's template (extending nbconvert's lab template), with its CSS and
+#: MathJax configuration beside it.
+TEMPLATE_DIR = Path(__file__).with_name("handout_template")
 _TEMPLATE_NAME = "lqe_handout.html.j2"
-
-_MATHJAX_CONFIG = r"""
-MathJax.Hub.Config({
-  TeX: {equationNumbers: {autoNumber: "AMS", useLabelIds: true}},
-  tex2jax: {
-    inlineMath: [["$", "$"], ["\\(", "\\)"]],
-    displayMath: [["$$", "$$"], ["\\[", "\\]"]],
-    processEscapes: true,
-    processEnvironments: true
-  },
-  "HTML-CSS": {
-    availableFonts: [], preferredFont: null, webFont: "STIX-Web", imageFont: null,
-    linebreaks: {automatic: true}
-  },
-  MMLorHTML: {prefer: {Firefox: "MML", other: "HTML"}},
-  menuSettings: {assistiveMML: true},
-  showMathMenu: false,
-  displayAlign: "center",
-  messageStyle: "none"
-});
-"""
-
-# WCAG 2.1 AA: text contrast >= 4.5:1 on the page's white and on the code cells' grey
-# (#f5f5f5); every colour below is >= 4.5:1 on both (checked in
-# tests/authoring/test_handout_pages.py).
-_CSS = r"""
-:root {
-  --jp-content-link-color: #0b57d0;
-  --jp-cell-inprompt-font-color: #1f5f99;
-  --jp-cell-outprompt-font-color: #a3321a;
-  --jp-cell-editor-background: #f5f5f5;
-  --jp-cell-prompt-not-active-opacity: 1;
-  --jp-cell-prompt-not-active-font-color: #595959;
-  --jp-content-font-color2: #4a4a4a;
-  --jp-content-font-color3: #595959;
-  --jp-mirror-editor-keyword-color: #006b00;
-  --jp-mirror-editor-atom-color: #0b4fa3;
-  --jp-mirror-editor-number-color: #006b00;
-  --jp-mirror-editor-def-color: #00508a;
-  --jp-mirror-editor-variable-color: #212121;
-  --jp-mirror-editor-variable-2-color: #1f4f7a;
-  --jp-mirror-editor-variable-3-color: #00698a;
-  --jp-mirror-editor-punctuation-color: #0b4fa3;
-  --jp-mirror-editor-property-color: #0b4fa3;
-  --jp-mirror-editor-operator-color: #8f1f8f;
-  --jp-mirror-editor-comment-color: #3d6b6b;
-  --jp-mirror-editor-string-color: #a31515;
-  --jp-mirror-editor-string-2-color: #8a3b00;
-  --jp-mirror-editor-meta-color: #8f1f8f;
-  --jp-mirror-editor-qualifier-color: #555555;
-  --jp-mirror-editor-builtin-color: #006b00;
-  --jp-mirror-editor-bracket-color: #616161;
-  --jp-mirror-editor-tag-color: #006b00;
-  --jp-mirror-editor-attribute-color: #00508a;
-  --jp-mirror-editor-header-color: #0b4fa3;
-  --jp-mirror-editor-quote-color: #006b00;
-  --jp-mirror-editor-link-color: #0b4fa3;
-  --jp-mirror-editor-error-color: #c40000;
-  --jp-mirror-editor-hr-color: #6b6b6b;
-}
-.jp-RenderedHTMLCommon a, nav.lqe-nav a { color: var(--jp-content-link-color); }
-/* Links in running text are underlined, so colour is never the only cue (WCAG 1.4.1). */
-.jp-RenderedHTMLCommon a, .jp-RenderedHTMLCommon a:link, .jp-RenderedHTMLCommon a:visited {
-  text-decoration: underline;
-}
-a:focus-visible {
-  outline: 3px solid #0b57d0; outline-offset: 2px; border-radius: 2px;
-}
-/* Reflow (WCAG 1.4.10): the text wraps at any width; code, wide tables and wide
-   equations scroll inside their own box, never the page. */
-body { overflow-wrap: break-word; }
-main { min-width: 0; }
-.jp-Cell, .jp-Cell-inputWrapper, .jp-Cell-outputWrapper, .jp-InputArea, .jp-OutputArea,
-.jp-OutputArea-child, .jp-OutputArea-output, .jp-RenderedHTMLCommon { min-width: 0; }
-.jp-InputArea, .jp-OutputArea-output pre, .jp-RenderedHTMLCommon pre,
-.jp-RenderedHTMLCommon table { overflow-x: auto; max-width: 100%; }
-.jp-RenderedHTMLCommon table { display: block; }
-.jp-RenderedHTMLCommon img, .jp-RenderedImage img { max-width: 100%; height: auto; }
-.MathJax_Display { overflow-x: auto; overflow-y: hidden; max-width: 100%; }
-@media (max-width: 760px) {
-  .jp-InputPrompt, .jp-OutputPrompt { display: none; }
-  /* Narrow or zoomed: code wraps instead of scrolling (a scrolling box would need
-     its own keyboard focus); leading spaces keep the indentation. */
-  .jp-InputArea pre, .jp-OutputArea-output pre { white-space: pre-wrap; overflow-wrap: anywhere; }
-  .jp-Notebook { padding: 4px; }
-}
-nav.lqe-nav {
-  display: flex; flex-wrap: wrap; justify-content: space-between; gap: 0.5em 1em;
-  max-width: 1100px; margin: 0.5em auto; padding: 0.4em 1em;
-  font-family: var(--jp-ui-font-family); font-size: 0.95em;
-  border-bottom: 1px solid var(--jp-border-color2);
-}
-nav.lqe-nav.lqe-nav-bottom { border-bottom: 0; border-top: 1px solid var(--jp-border-color2); }
-figure.lqe-explorer { margin: 0; }
-figure.lqe-explorer img { max-width: 100%; height: auto; }
-figure.lqe-explorer figcaption { color: var(--jp-content-font-color2); margin-top: 0.3em; }
-"""
-
-_TEMPLATE = r"""
-{%- extends 'index.html.j2' -%}
-
-{%- macro lqe_nav(nav, where) -%}
-{%- if nav -%}
-<nav class="lqe-nav lqe-nav-{{ where }}" aria-label="Handout pages ({{ where }})">
-  <span>{%- if nav.previous -%}
-    <a rel="prev" href="{{ nav.previous.href }}">&larr; Previous: {{ nav.previous.title | e }}</a>
-  {%- endif -%}</span>
-  <a href="{{ nav.index }}">All handout pages</a>
-  <span>{%- if nav.next -%}
-    <a rel="next" href="{{ nav.next.href }}">Next: {{ nav.next.title | e }} &rarr;</a>
-  {%- endif -%}</span>
-</nav>
-{%- endif -%}
-{%- endmacro -%}
-
-{%- block html_head_js_requirejs -%}{%- endblock html_head_js_requirejs -%}
-{%- block jupyter_widgets -%}{%- endblock jupyter_widgets -%}
-{%- block html_head_js_mermaidjs -%}{%- endblock html_head_js_mermaidjs -%}
-
-{%- block html_head_js_mathjax -%}
-{%- if resources.mathjax_url -%}
-<script type="text/x-mathjax-config">{{ resources.lqe_mathjax_config }}</script>
-<script async src="{{ resources.mathjax_url | e }}"></script>
-{%- endif -%}
-{%- endblock html_head_js_mathjax -%}
-
-{#- After the lab theme's CSS, so the colours here win. -#}
-{%- block html_head_css -%}
-<style type="text/css">{{ resources.lqe_css }}</style>
-{%- endblock html_head_css -%}
-
-{%- block body_header -%}
-{%- if resources.theme == 'dark' -%}
-<body class="jp-Notebook" data-jp-theme-light="false" data-jp-theme-name="JupyterLab Dark">
-{%- else -%}
-<body class="jp-Notebook" data-jp-theme-light="true" data-jp-theme-name="JupyterLab Light">
-{%- endif %}
-{{ lqe_nav(resources.lqe_nav, 'top') }}
-<main>
-{%- endblock body_header -%}
-
-{%- block body_footer -%}
-</main>
-{{ lqe_nav(resources.lqe_nav, 'bottom') }}
-</body>
-{%- endblock body_footer -%}
-
-{% block data_png scoped %}
-<div class="jp-RenderedImage jp-OutputArea-output {{ extra_class }}">
-{%- set alt = (output | get_metadata('alt', 'image/png') or '') | trim -%}
-<img src="data:image/png;base64,{{ output.data['image/png'] | escape_html }}"
-{%- if alt %} alt="{{ alt | escape_html }}"{% endif %}>
-</div>
-{%- endblock data_png %}
-
-{% block data_jpg scoped %}
-<div class="jp-RenderedImage jp-OutputArea-output {{ extra_class }}">
-{%- set alt = (output | get_metadata('alt', 'image/jpeg') or '') | trim -%}
-<img src="data:image/jpeg;base64,{{ output.data['image/jpeg'] | escape_html }}"
-{%- if alt %} alt="{{ alt | escape_html }}"{% endif %}>
-</div>
-{%- endblock data_jpg %}
-"""
 
 
 def mathjax_root() -> Path:
@@ -367,16 +207,6 @@ def broken_pngs(notebook: nbformat.NotebookNode) -> list[str]:
             and (fault := png_fault(output["data"]["image/png"])) is not None]
 
 
-class _PageResources(Preprocessor):
-    """Put the page's MathJax configuration and CSS into the template's resources."""
-
-    def preprocess(self, nb: nbformat.NotebookNode,
-                   resources: dict) -> tuple[nbformat.NotebookNode, dict]:
-        resources["lqe_mathjax_config"] = _MATHJAX_CONFIG
-        resources["lqe_css"] = _CSS
-        return nb, resources
-
-
 class NotebookLinkPreprocessor(Preprocessor):
     """Point markdown links to another notebook of the pack at that notebook's page.
 
@@ -445,9 +275,8 @@ def handout_exporter(*, code: bool = True, mathjax_url: str = "",
         config.TemplateExporter.exclude_input_prompt = True
         config.TemplateExporter.exclude_output_prompt = True
     exporter = HTMLExporter(config=config, template_name="lab",
-                            extra_loaders=[DictLoader({_TEMPLATE_NAME: _TEMPLATE})])
+                            extra_template_paths=[str(TEMPLATE_DIR)])
     exporter.template_file = _TEMPLATE_NAME
-    exporter.register_preprocessor(_PageResources(), enabled=True)
     exporter.register_preprocessor(NotebookLinkPreprocessor(stems=list(stems)), enabled=True)
     return exporter
 

@@ -9,7 +9,7 @@
     build/handouts/prose/NN_name.html  prose, printed results and figures only
 
 Each notebook is executed once, in a fresh kernel, by
-:func:`lqe_helpers.authoring.notebook_runner.execute_notebook`. A notebook that raises, shows an
+:func:`lqe_helpers.authoring.execution.execute_notebook`. A notebook that raises, shows an
 error output, or displays a widget with no static view (which a page could only show
 as a placeholder) stops the build, and the message names the notebook and the cell
 (and gives the traceback); output on stderr (a warning) is reported but kept. A cell
@@ -68,12 +68,9 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 PROSE_DIR = "prose"
 #: Title of the index pages.
 PACK_TITLE = "The Linear Quadratic Estimator: tracking a butterfly"
-#: ``mathjax_url`` that copies MathJax into the output folder and loads it from there.
+#: ``mathjax_url`` that copies MathJax into the output folder and loads it from there
+#: (the default).
 LOCAL_MATHJAX = "local"
-#: Where the pages load MathJax from by default: the copy in the output folder.
-DEFAULT_MATHJAX_URL = LOCAL_MATHJAX
-#: What an HTML page may show from a display bundle, best first (no widget view).
-DISPLAY_PRIORITY = handout_pages.DISPLAY_PRIORITY
 
 #: Name the handouts build records in its output folder's manifest.
 TOOL_NAME = "handouts"
@@ -117,58 +114,6 @@ def notebook_title(notebook: nbformat.NotebookNode, fallback: str) -> str:
     return headings[0].lstrip("#").strip() if headings else fallback
 
 
-def error_outputs(notebook: nbformat.NotebookNode) -> list[str]:
-    """Where ``notebook`` shows an error: ``"cell N: Name: message"`` per error output.
-
-    ``N`` counts every cell (markdown included) from 0.
-    """
-    found = []
-    for index, cell in enumerate(notebook.cells):
-        for output in cell.get("outputs", []):
-            if output.get("output_type") == "error":
-                found.append(f"cell {index}: {output.get('ename')}: {output.get('evalue')}")
-    return found
-
-
-def error_tracebacks(notebook: nbformat.NotebookNode) -> list[str]:
-    """The traceback of each error output, as plain text headed ``"cell N:"``.
-
-    In the order of :func:`error_outputs`, without the terminal colour codes.
-    """
-    return [
-        f"cell {index}:\n" + strip_ansi("\n".join(output.get("traceback", []))).strip()
-        for index, cell in enumerate(notebook.cells)
-        for output in cell.get("outputs", [])
-        if output.get("output_type") == "error"
-    ]
-
-
-def unshowable_widgets(notebook: nbformat.NotebookNode) -> list[str]:
-    """Where ``notebook`` displays a widget with nothing but text beside it.
-
-    An explorer's output also carries its figure (``text/html`` and ``image/png``); a
-    bare ipywidget carries only ``text/plain`` ("VBox(children=...)"), which is what
-    a page would show in place of the sliders.
-    """
-    static = set(DISPLAY_PRIORITY) - {"text/plain"}
-    return [
-        f"cell {index}: {output.get('data', {}).get('text/plain', 'a widget')!s:.60}"
-        for index, cell in enumerate(notebook.cells)
-        for output in cell.get("outputs", [])
-        if WIDGET_VIEW_MIMETYPE in output.get("data", {}) and not static & set(output["data"])
-    ]
-
-
-def stderr_outputs(notebook: nbformat.NotebookNode) -> list[str]:
-    """Where ``notebook`` printed to stderr: ``"cell N: first line"`` per stream."""
-    return [
-        f"cell {index}: {(output.get('text', '').strip().splitlines() or [''])[0]}"
-        for index, cell in enumerate(notebook.cells)
-        for output in cell.get("outputs", [])
-        if output.get("output_type") == "stream" and output.get("name") == "stderr"
-    ]
-
-
 def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNode:
     """A one-cell notebook whose markdown lists ``pages`` in order (the index page)."""
     if code:
@@ -192,6 +137,34 @@ def _index_notebook(pages: Sequence[Page], *, code: bool) -> nbformat.NotebookNo
     return notebook
 
 
+def output_problems(notebook: nbformat.NotebookNode) -> dict[str, list[str]]:
+    """What a page of ``notebook`` would show that a reader should not see, in one pass.
+
+    ``"error"``: ``"cell N: Name: message"`` per error output; ``"traceback"``: its
+    traceback as plain text headed ``"cell N:"``; ``"widget"``: a widget displayed with
+    nothing but text beside it (an explorer's output also carries its figure; a bare
+    ipywidget only ``text/plain``, which a page would show in place of the sliders);
+    ``"stderr"``: ``"cell N: first line"`` per stream printed to stderr. ``N`` counts
+    every cell (markdown included) from 0.
+    """
+    found: dict[str, list[str]] = {"error": [], "traceback": [], "widget": [], "stderr": []}
+    static = set(handout_pages.DISPLAY_PRIORITY) - {"text/plain"}
+    for index, cell in enumerate(notebook.cells):
+        for output in cell.get("outputs", []):
+            data, kind = output.get("data", {}), output.get("output_type")
+            if kind == "error":
+                found["error"].append(f"cell {index}: {output.get('ename')}: "
+                                      f"{output.get('evalue')}")
+                found["traceback"].append(f"cell {index}:\n" + strip_ansi(
+                    "\n".join(output.get("traceback", []))).strip())
+            elif kind == "stream" and output.get("name") == "stderr":
+                first = (output.get("text", "").strip().splitlines() or [""])[0]
+                found["stderr"].append(f"cell {index}: {first}")
+            if WIDGET_VIEW_MIMETYPE in data and not static & set(data):
+                found["widget"].append(f"cell {index}: {data.get('text/plain', 'a widget')!s:.60}")
+    return found
+
+
 def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode:
     """Execute ``path`` fresh; raise :class:`HandoutBuildError` if its page would be broken.
 
@@ -205,17 +178,16 @@ def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode
         notebook = execute_notebook(path, timeout, allow_errors=True)
     except NotebookRunError as error:
         raise HandoutBuildError(str(error)) from error
-    errors = error_outputs(notebook)
-    if errors:
+    found = output_problems(notebook)
+    if found["error"]:
         raise HandoutBuildError(f"{path} shows error output(s): "
-                                f"{summarise(errors, separator='; ')}\n"
-                                f"Traceback of the first, {error_tracebacks(notebook)[0]}")
-    widgets = unshowable_widgets(notebook)
-    if widgets:
+                                f"{summarise(found['error'], separator='; ')}\n"
+                                f"Traceback of the first, {found['traceback'][0]}")
+    if found["widget"]:
         raise HandoutBuildError(
             f"{path} displays widget(s) with no static view, which a page could only show "
             f"as a placeholder (display an Explorer, or a figure): "
-            f"{summarise(widgets, separator='; ')}")
+            f"{summarise(found['widget'], separator='; ')}")
     broken = handout_pages.broken_pngs(notebook)
     if broken:
         raise HandoutBuildError(f"{path} shows image/png output(s) that are not a valid PNG, "
@@ -227,11 +199,10 @@ def _execute(path: Path, timeout: float = CELL_TIMEOUT) -> nbformat.NotebookNode
                       f"only give a generic alt text (show them with plotting.show_figure): "
                       f"{summarise(undescribed, separator='; ')}",
                       HandoutWarning, stacklevel=3)
-    printed = stderr_outputs(notebook)
-    if printed:
+    if found["stderr"]:
         warnings.warn(f"{path} prints to stderr, which its page will show: "
-                      f"{summarise(printed, separator='; ')}", HandoutWarning, stacklevel=3)
-    notebook.metadata.pop("widgets", None)
+                      f"{summarise(found['stderr'], separator='; ')}", HandoutWarning,
+                      stacklevel=3)
     return notebook
 
 
@@ -242,7 +213,7 @@ def _page_names(stems: Sequence[str]) -> list[str]:
 
 
 def build_handouts(source_dir: Path, out_dir: Path, *,
-                   mathjax_url: str = DEFAULT_MATHJAX_URL,
+                   mathjax_url: str = LOCAL_MATHJAX,
                    timeout: float = CELL_TIMEOUT) -> list[Path]:
     """Execute every notebook in ``source_dir`` and write its handout pages to ``out_dir``.
 
@@ -343,7 +314,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     parser.add_argument("--out", type=Path, default=Path("build/handouts"),
                         help="output folder (default: build/handouts); a rebuild replaces only "
                              "the files listed in its .lqe-manifest.json")
-    parser.add_argument("--mathjax-url", default=DEFAULT_MATHJAX_URL,
+    parser.add_argument("--mathjax-url", default=LOCAL_MATHJAX,
                         help=f"where pages load MathJax from: '{LOCAL_MATHJAX}' (default) copies "
                              "it into the output folder; '' for none (LaTeX shown as text)")
     parser.add_argument("--timeout", type=positive_seconds, default=CELL_TIMEOUT,

@@ -37,9 +37,9 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
-    from lqe_helpers.authoring.grading import graded_cells
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
+    from lqe_helpers.authoring.points import CHECK_NAME, graded_cells, is_check_cell
     from lqe_helpers.authoring.task_cells import (
         ANSWER_TAG,
         CHECK_CALL,
@@ -61,8 +61,6 @@ QUESTION_MARKS = {"a": 15, "b": 15, "c": 25, "d": 15, "e": 30}
 #: Question of each notebook by its number (the fallback when its metadata has none).
 NOTEBOOK_QUESTIONS = {"00": "background", "01": "a", "02": "b", "03": "c", "04": "d",
                       "05": "e", "06": "bonus"}
-#: The function a check cell calls.
-CHECK_FUNCTION = re.compile(r"\bchecks\.(check_\w+)\s*\(")
 #: A tolerance constant named in a check's docstring (``:data:`MSE_RTOL```).
 TOLERANCE_CONSTANT = re.compile(r":data:`(\w*TOL\w*)`")
 #: A tolerance stated in words in a check's docstring ("relative tolerance 1e-6").
@@ -187,7 +185,7 @@ def check_tolerance(call: str) -> str:
     """
     from lqe_helpers import checks  # only when a guide is built
 
-    match = CHECK_FUNCTION.search(call)
+    match = CHECK_NAME.search(call)
     if match is None:
         raise ValueError(f"a check cell must call {CHECK_CALL}…(…), got {call!r}")
     function = getattr(checks, match.group(1), None)
@@ -264,8 +262,7 @@ def notebook_guide(notebook: nbformat.NotebookNode, name: str) -> NotebookGuide:
             instruction = " ".join(line.lstrip("#").strip()
                                    for line in task_instruction(cell.source))
             after = cells[index + 1] if index + 1 < len(cells) else None
-            check = (after.source.strip() if after is not None and after.cell_type == "code"
-                     and CHECK_CALL in after.source and not cell_tags(after) else None)
+            check = after.source.strip() if is_check_cell(after) else None
             printed = "".join(output.get("text", "") for output in after.get("outputs", [])
                               ).strip() if check else ""
             items.append(Task(where, instruction, core, check,

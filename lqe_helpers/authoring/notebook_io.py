@@ -1,8 +1,9 @@
-"""Notebook files: read one and check it is a notebook, list a folder's, save one.
+"""Notebook files: read one and check it is a notebook, list a folder's, a notebook's bytes.
 
 Every tool reads notebooks through :func:`read_notebook`, whose one-line errors name the
-file; :func:`notebook_bytes` is exactly what :func:`nbformat.write` saves, and
-:func:`write_notebook` saves it atomically (:mod:`lqe_helpers.authoring.files`).
+file; :func:`notebook_bytes` is exactly what :func:`nbformat.write` saves (the tools write
+it through :mod:`lqe_helpers.authoring.output_folder` or
+:func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from lqe_helpers.authoring.errors import NotebookFileError, first_line, shown, summarise
-from lqe_helpers.authoring.files import atomic_write_bytes
 
 if TYPE_CHECKING:
     import nbformat
@@ -166,8 +166,3 @@ def notebook_bytes(notebook: nbformat.NotebookNode) -> bytes:
     if not text.endswith("\n"):
         text += "\n"
     return text.encode("utf-8")
-
-
-def write_notebook(path: Path | str, notebook: nbformat.NotebookNode) -> Path:
-    """Save ``notebook`` at ``path`` atomically (see :func:`atomic_write_bytes`)."""
-    return atomic_write_bytes(path, notebook_bytes(notebook))

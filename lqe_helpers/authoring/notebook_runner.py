@@ -26,12 +26,10 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from collections.abc import Sequence
     from pathlib import Path
 
-    from lqe_helpers.authoring.command_line import CommandLineParser, fail, run_command
+    from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import NotebookFileError, shown, summarise
     from lqe_helpers.authoring.execution import (
         CELL_TIMEOUT,
-        WIDGET_VIEW_MIMETYPE,
-        NotebookRunError,
         execute_notebook,
         positive_seconds,
     )
@@ -42,9 +40,6 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         parse_notebook,
         read_notebook_bytes,
     )
-
-__all__ = ["CELL_TIMEOUT", "TOOL_NAME", "WIDGET_VIEW_MIMETYPE", "NotebookRunError",
-           "execute_notebook", "fail", "main", "positive_seconds", "run_notebooks"]
 
 #: The name the runner records in the journal of a save.
 TOOL_NAME = "notebook_runner"
@@ -77,7 +72,6 @@ def _check_paths(paths: Sequence[Path]) -> dict[Path, FileState]:
 
 
 def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
-                  kernel_name: str = "python3",
                   log: bool = True) -> tuple[list[Path], list[Path]]:
     """Execute each notebook and save it in place, all or none.
 
@@ -95,8 +89,6 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
         The notebooks (``.ipynb`` files; not symbolic links).
     timeout : float
         Seconds one cell may run.
-    kernel_name : str
-        Kernel to start for each notebook.
     log : bool
         Print ``executing <path>`` before each run.
 
@@ -126,7 +118,7 @@ def run_notebooks(paths: Sequence[Path | str], *, timeout: float = CELL_TIMEOUT,
         for path, state in checked.items():
             if log:
                 print(f"executing {shown(path)}", flush=True)
-            content = notebook_bytes(execute_notebook(path, timeout, kernel_name))
+            content = notebook_bytes(execute_notebook(path, timeout))
             if file_state(path) != state:
                 results[path] = content  # changed meanwhile: the save below keeps it
             elif path.read_bytes() != content:

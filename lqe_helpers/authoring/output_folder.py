@@ -36,7 +36,7 @@ from lqe_helpers.authoring.manifest import (
     name_problem,
     read_manifest,
 )
-from lqe_helpers.authoring.swap import swap_in
+from lqe_helpers.authoring.swap import swap_folders
 
 
 def _ancestors(path: Path) -> list[Path]:
@@ -135,13 +135,9 @@ def check_output_names(names: Iterable[str]) -> list[str]:
 class OutputPlan:
     """What :func:`write_output_folder` will do: checked before anything changes."""
 
-    out_dir: Path
-    tool: str
-    exists: bool
     replace: tuple[str, ...]
     create: tuple[str, ...]
     delete: tuple[str, ...]
-    keep: tuple[str, ...]
     ours: Mapping[str, str]
 
 
@@ -172,9 +168,9 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
     -------
     OutputPlan
         ``replace``: files of ours to be overwritten; ``create``: new files; ``delete``:
-        files of ours from an earlier build no longer written; ``keep``: files in the
-        manifest that were changed or replaced since, and so are left alone (and dropped
-        from the manifest); ``ours``: the manifest's entries.
+        files of ours from an earlier build no longer written; ``ours``: the manifest's
+        entries. A file of the manifest changed or replaced since is left alone (and
+        dropped from the manifest).
 
     Raises
     ------
@@ -188,7 +184,7 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
     names = check_output_names(names)
     check_output_location(out_dir, sources)
     if not out_dir.exists():
-        return OutputPlan(out_dir, tool, False, (), tuple(names), (), (), {})
+        return OutputPlan((), tuple(names), (), {})
     manifest = read_manifest(out_dir)
     if manifest is not None and manifest.tool != tool:
         raise OutputFolderError(
@@ -230,9 +226,7 @@ def plan_output_folder(out_dir: Path | str, names: Iterable[str], *, tool: str,
             f"changed; move those files away, or give another output folder")
     wanted = set(names)
     delete = sorted(name for name in unchanged if name not in wanted)
-    keep = sorted(name for name in ours if name not in wanted and name not in unchanged)
-    return OutputPlan(out_dir, tool, True, tuple(replace), tuple(create), tuple(delete),
-                      tuple(keep), dict(ours))
+    return OutputPlan(tuple(replace), tuple(create), tuple(delete), dict(ours))
 
 
 @contextlib.contextmanager
@@ -259,7 +253,7 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
     checks it (:func:`plan_output_folder`): a file in the way that the tool did not
     write, or changed since, stops the build before anything is written. Then the files
     and the manifest are swapped in and the files of an earlier build no longer written
-    deleted (:func:`~lqe_helpers.authoring.swap.swap_in`, all or nothing).
+    deleted (:func:`~lqe_helpers.authoring.swap.swap_folders`, all or nothing).
 
     Parameters
     ----------
@@ -285,25 +279,7 @@ def write_output_folder(out_dir: Path | str, files: Mapping[str, bytes | str], *
         If writing fails part-way (disk full, no permission); ``out_dir`` is then as
         it was.
     """
-    out_dir = Path(out_dir)
-    contents = {name: as_bytes(data) for name, data in files.items()}
-    check_output_names(contents)
-    check_output_location(out_dir, sources)
-    try:
-        with _held_folder(out_dir):
-            plan = plan_output_folder(out_dir, contents, tool=tool, sources=sources)
-            manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
-            expected = {**{name: None for name in plan.create},
-                        **{name: plan.ours[name] for name in plan.replace}}
-            swap_in(out_dir, {**contents, MANIFEST_NAME: manifest.to_bytes()},
-                    {name: plan.ours[name] for name in plan.delete}, tool=tool,
-                    expected=expected)
-    except OSError as error:
-        where = f" ({shown(error.filename)})" if error.filename else ""
-        raise OutputWriteError(
-            f"cannot write into {shown(out_dir)}: {error.strerror or error}{where}; "
-            f"it was left as it was") from error
-    return [out_dir / name for name in contents]
+    return build_output_folder(out_dir, list(files), lambda: files, tool=tool, sources=sources)
 
 
 def build_output_folder(out_dir: Path | str, names: Sequence[str],
@@ -313,7 +289,8 @@ def build_output_folder(out_dir: Path | str, names: Sequence[str],
 
     An existing folder is held (and a killed swap there recovered) *before* it is checked
     for ``names``, and for the whole (perhaps long) build, so a second tool on it stops
-    at once; then :func:`write_output_folder` writes the files ``build`` returns.
+    at once; then the files ``build`` returns are written as :func:`write_output_folder`
+    says.
 
     Returns
     -------
@@ -325,7 +302,23 @@ def build_output_folder(out_dir: Path | str, names: Sequence[str],
     check_output_location(out_dir, sources)
     with FolderLock(out_dir) if out_dir.is_dir() else contextlib.nullcontext():
         plan_output_folder(out_dir, names, tool=tool, sources=sources)
-        return write_output_folder(out_dir, build(), tool=tool, sources=sources)
+        contents = {name: as_bytes(data) for name, data in build().items()}
+        try:
+            with _held_folder(out_dir):
+                plan = plan_output_folder(out_dir, contents, tool=tool, sources=sources)
+                manifest = Manifest(tool, {name: sha256(data) for name, data in contents.items()})
+                expected = {**{name: None for name in plan.create},
+                            **{name: plan.ours[name] for name in plan.replace}}
+                writes = {**contents, MANIFEST_NAME: manifest.to_bytes()}
+                deletes = {name: plan.ours[name] for name in plan.delete}
+                swap_folders({out_dir: (writes, deletes, expected, {})}, tool, shown(out_dir),
+                             strict=True)
+        except OSError as error:
+            where = f" ({shown(error.filename)})" if error.filename else ""
+            raise OutputWriteError(
+                f"cannot write into {shown(out_dir)}: {error.strerror or error}{where}; "
+                f"it was left as it was") from error
+    return [out_dir / name for name in contents]
 
 
 def remove_output_folder(out_dir: Path | str) -> tuple[list[Path], list[Path]] | None:

@@ -65,80 +65,22 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     )
 
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
-
-    # MANIFEST_NAME and the Output*Error classes are re-exported: where the build records
-    # what it wrote, and what build_student_edition raises.
-    from lqe_helpers.authoring.errors import OutputFolderError as OutputFolderError
-    from lqe_helpers.authoring.errors import OutputWriteError as OutputWriteError
     from lqe_helpers.authoring.errors import shown
-    from lqe_helpers.authoring.manifest import MANIFEST_NAME as MANIFEST_NAME
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
-
-    # The cell convention is part of the student edition's interface: re-exported here.
     from lqe_helpers.authoring.task_cells import (
-        ALLOWED_TAGS,
-        ANSWER_PROMPT,
         ANSWER_PROMPT_TAG,
         ANSWER_TAG,
-        CHECK_CALL,
         EXPLORER_TAG,
-        GOING_FURTHER,
         IGNORE_OUTPUT_TAG,
         SOLUTION_TAG,
-        STUB_MESSAGE,
-        TASK_LIKE,
-        TASK_PREFIX,
         TASK_TAG,
-        answer_headings,
         cell_place,
         cell_tags,
         check_cell_tags,
-        function_stub,
         prompt_source,
         stub_source,
-        task_instruction,
     )
-
-__all__ = [
-    "ALLOWED_TAGS",
-    "ANSWER_PROMPT",
-    "ANSWER_PROMPT_TAG",
-    "ANSWER_TAG",
-    "CHECK_CALL",
-    "EXPLORER_TAG",
-    "GOING_FURTHER",
-    "IGNORE_OUTPUT_TAG",
-    "MANIFEST_NAME",
-    "NOTE_TAG",
-    "SOLUTION_TAG",
-    "STUB_MESSAGE",
-    "STUDENT_NOTE",
-    "STUDENT_TAGS",
-    "TASK_LIKE",
-    "TASK_PREFIX",
-    "TASK_TAG",
-    "TOOL_NAME",
-    "MissingSolutionsError",
-    "MissingSolutionsWarning",
-    "OutputFolderError",
-    "OutputWriteError",
-    "StudentEditionPreprocessor",
-    "answer_headings",
-    "build_student_edition",
-    "cell_place",
-    "cell_tags",
-    "check_cell_tags",
-    "check_has_solutions",
-    "count_solutions",
-    "function_stub",
-    "main",
-    "prompt_source",
-    "stub_source",
-    "student_edition",
-    "student_exporter",
-    "task_instruction",
-]
 
 #: Name the student edition records in its output folder's manifest.
 TOOL_NAME = "student_edition"

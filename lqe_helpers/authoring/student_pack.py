@@ -6,10 +6,11 @@
 
 - ``notebooks/``: the student edition of every notebook (tasks as stubs, answers as
   prompts; built as ``make student`` builds it, and refused for the same reasons);
-- ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/``. Those are the
-  instructor's tools (run notebooks, build handouts, the student edition, this pack,
-  the marking guide); nothing a student runs (notebooks, explorers, checks, ``make lab``,
-  ``make test``) imports them, and leaving them out keeps the pack to what students use;
+- ``lqe_helpers/``: the package, **without** ``lqe_helpers/authoring/`` and
+  ``lqe_helpers/grading/``. Those are the instructor's tools (run notebooks, build
+  handouts, the student edition, this pack, the marking guide, grading); nothing a
+  student runs (notebooks, explorers, checks, ``make lab``, ``make test``) imports
+  them, and leaving them out keeps the pack to what students use;
 - ``README.md``: the students' own (:data:`STUDENT_README`: what to run, how to work a
   notebook, where help is), not the course's, which speaks to instructors and
   maintainers; ``pyproject.toml``, ``constraints.txt``;
@@ -46,8 +47,10 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from pathlib import Path
 
     from lqe_helpers.authoring import student_edition as se
+    from lqe_helpers.authoring import task_cells as tc
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
+    from lqe_helpers.authoring.files import refuse_symlink
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
     from lqe_helpers.authoring.output_folder import build_output_folder
 
@@ -57,14 +60,15 @@ TOOL_NAME = "student_pack"
 PACK_NAME = "lqe-student-pack"
 #: The zip written in the output folder.
 ZIP_NAME = f"{PACK_NAME}.zip"
-#: What the pack is, at its top level (also marks an unpacked folder as a student pack).
+#: What the pack is, at its top level (also marks an unpacked folder as a student pack);
+#: its text is the file of that name in :data:`PACK_FILES`.
 MARKER_NAME = "STUDENT-PACK.md"
 #: Files copied from the top of the course folder as they are.
 TOP_FILES = ("pyproject.toml", "constraints.txt")
 #: Folders of the course folder the pack copies from; its output folder may not overlap them.
 SOURCES = ("notebooks", "lqe_helpers", "tests")
 #: Sub-packages of lqe_helpers that stay with the instructor.
-INSTRUCTOR_PACKAGES = ("authoring",)
+INSTRUCTOR_PACKAGES = ("authoring", "grading")
 #: The only files of tests/ the pack ships (every other one stays with the instructor):
 #: tests of the pack's infrastructure that hold no worked answer and no task's result.
 PACK_TESTS = ("conftest.py", "test_validation.py", "test_public_errors.py",
@@ -145,13 +149,6 @@ def source_folders(root: Path) -> list[Path]:
     return [Path(root) / name for name in SOURCES]
 
 
-def _refuse_link(path: Path) -> None:
-    if path.is_symlink():
-        raise ValueError(f"{shown(path)} is a symbolic link; the student pack copies only real "
-                         f"files (a link could bring in any file, the marking guide say): "
-                         f"put the file itself there, or remove the link")
-
-
 def _files_under(folder: Path) -> list[Path]:
     """Every regular file under ``folder``, sorted; ``__pycache__``, ``.pyc`` and ``.pyo`` left out.
 
@@ -161,12 +158,12 @@ def _files_under(folder: Path) -> list[Path]:
         Naming the first symbolic link, or the first entry that is neither a file nor a
         folder (a fifo, a device, a socket), found in ``folder``.
     """
-    _refuse_link(folder)
+    refuse_symlink(folder)
     found = []
     for path in sorted(folder.rglob("*")):
         if "__pycache__" in path.relative_to(folder).parts:
             continue
-        _refuse_link(path)
+        refuse_symlink(path)
         if path.is_dir():
             continue
         if not path.is_file():
@@ -179,18 +176,13 @@ def _files_under(folder: Path) -> list[Path]:
 
 def _read_text(path: Path) -> str:
     """The UTF-8 text of the file ``path`` (not a link); a failure names the file."""
-    _refuse_link(path)
+    refuse_symlink(path)
     data = path.read_bytes()
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:
         raise ValueError(f"{shown(path)} is not UTF-8 text ({error.reason} at byte "
                          f"{error.start}); save it as UTF-8") from None
-
-
-def _read_bytes(path: Path) -> bytes:
-    _refuse_link(path)
-    return path.read_bytes()
 
 
 def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[str, bytes]:
@@ -237,7 +229,7 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
             files[f"lqe_helpers/{relative.as_posix()}"] = path.read_bytes()
     for name in PACK_TESTS:
         path = root / "tests" / name
-        _refuse_link(path)
+        refuse_symlink(path)
         if not path.is_file():
             raise ValueError(f"{shown(path)} is not a regular file (a fifo, a device or a "
                              f"folder); the student pack copies only files: put the test "
@@ -245,46 +237,22 @@ def pack_contents(root: Path, *, allow_without_solutions: bool = False) -> dict[
         files[f"tests/{name}"] = _read_text(path).encode()  # non-UTF-8 text stops it, named
     files[f"tests/{STRUCTURE_TEST}"] = (PACK_FILES / STRUCTURE_TEST).read_bytes()
     conventions = {
-        "tags": sorted(se.STUDENT_TAGS), "task_tag": se.TASK_TAG,
-        "task_prefix": se.TASK_PREFIX, "check_call": se.CHECK_CALL,
-        "going_further": se.GOING_FURTHER, "notebooks": names,
+        "tags": sorted(se.STUDENT_TAGS), "task_tag": tc.TASK_TAG,
+        "task_prefix": tc.TASK_PREFIX, "check_call": tc.CHECK_CALL,
+        "going_further": tc.GOING_FURTHER, "notebooks": names,
         "checked_notebooks": [name for name in names if name.startswith(CHECKED_PREFIXES)],
     }
     files[f"tests/{CONVENTIONS_NAME}"] = (json.dumps(conventions, indent=1) + "\n").encode()
     files["Makefile"] = pack_makefile(_read_text(root / "Makefile")).encode()
     files["README.md"] = _read_text(PACK_FILES / STUDENT_README).encode()
     for name in TOP_FILES:
-        files[name] = _read_bytes(root / name)
-    files[MARKER_NAME] = marker_text().encode()
+        files[name] = _read_text(root / name).encode()
+    files[MARKER_NAME] = _read_text(PACK_FILES / MARKER_NAME).encode()
     for name in files:  # a zip names its files in UTF-8
         if name.encode("utf-8", "replace").decode("utf-8") != name:
             raise ValueError(f"{shown(root / name)}: its name is not UTF-8; the student pack "
                              f"(a zip) names its files in UTF-8: rename it")
     return dict(sorted(files.items()))
-
-
-def marker_text() -> str:
-    """The text of :data:`MARKER_NAME`."""
-    return """# The LQE course pack: student pack
-
-This folder is the course pack for students. The notebooks in `notebooks/` are the
-student edition: every cell that starts with `# Task:` is yours to write, and every
-**Your answer** cell yours to fill in.
-
-```bash
-make lab     # first run: creates .venv, installs everything, opens JupyterLab on notebooks/
-make test    # checks the installation and the structure of the notebooks
-```
-
-`make test` here does not run the notebooks (your unfinished tasks would stop it by design);
-it checks that each notebook is valid, carries only the student edition's tags, has a check
-after every core task, and that its imports resolve. The checks inside the notebooks tell you
-whether your code is right: run a task, then the check cell below it.
-
-Left out of this pack, for the instructor: the worked notebooks, the marking guide, the
-authoring tools (`lqe_helpers/authoring/`) and every test that is not about this
-installation. `README.md` says how to work through the notebooks.
-"""
 
 
 def zip_bytes(files: dict[str, bytes]) -> bytes:

@@ -1,6 +1,7 @@
 """Swap a finished build into a folder with renames; one tool at a time; survive a kill.
 
-A swap (:func:`swap_in`, :func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`) in a folder:
+A swap (:func:`swap_folders`: a build's output folder, or
+:func:`~lqe_helpers.authoring.folder_lock.atomic_write_many`) in a folder:
 
 1. writes every new file into a temporary folder beside them, ``.lqe-build-<16 hex>/``
    (``new/<name>``, linked into place later, so it proves which files the swap placed),
@@ -383,27 +384,24 @@ def _undone_on_failure(swaps: list[tuple[Path, Journal]], where: str) -> Iterato
         raise
 
 
-def swap_in(folder: Path, writes: Mapping[str, bytes], deletes: Mapping[str, str], *,
-            tool: str, expected: Mapping[str, str | None]) -> None:
-    """Swap ``writes`` (name → content; the manifest last) into ``folder``, which the caller
-    holds, and delete ``deletes`` (name → SHA-256 it must hold); all or nothing.
-    ``expected``: name → the SHA-256 the file must hold right before its rename (``None``:
-    absent), as the caller checked it.
-
-    Raises
-    ------
-    OutputFolderError
-        If a file changed since the caller looked (everything is then undone).
-    """
-    swap_folders({folder: (writes, deletes, expected, {})}, tool, shown(folder), strict=True)
-
-
 def swap_folders(plans: Mapping[Path, tuple[Mapping[str, bytes], Mapping[str, str],
                                      Mapping[str, str | None], Mapping[str, FileState]]],
           tool: str, where: str, *, strict: bool) -> set[tuple[Path, str]]:
     """Swap each folder's (writes, deletes, expected SHA-256s, expected states); every
     folder is staged before the first rename. Return the (folder, name)s kept as changed
-    (``strict``: a changed file undoes everything instead)."""
+    (``strict``: a changed file undoes everything instead).
+
+    Each folder is held by the caller. ``writes``: name → content (the manifest last);
+    ``deletes``: name → the SHA-256 it must hold; expected SHA-256s: name → the SHA-256
+    the file must hold right before its rename (``None``: absent), as the caller checked
+    it; expected states: name → its :class:`FileState` when the caller read it.
+
+    Raises
+    ------
+    OutputFolderError
+        If ``strict`` and a file changed since the caller looked (everything is then
+        undone).
+    """
     swaps: list[tuple[Path, Journal]] = []
     kept: set[tuple[Path, str]] = set()
     with signals_deferred():

@@ -142,10 +142,10 @@ def test_missing_or_folder_notebooks_are_clear_errors(tmp_path):
         notebook_io.read_notebook(tmp_path)
 
 
-def test_write_notebook_matches_nbformat_write(tmp_path):
+def test_notebook_bytes_match_nbformat_write(tmp_path):
     notebook = new_notebook(cells=[new_code_cell("print('é')")])
     nbformat.write(notebook, tmp_path / "reference.ipynb")
-    notebook_io.write_notebook(tmp_path / "ours.ipynb", notebook)
+    (tmp_path / "ours.ipynb").write_bytes(notebook_io.notebook_bytes(notebook))
     assert (tmp_path / "ours.ipynb").read_bytes() == (tmp_path / "reference.ipynb").read_bytes()
     assert notebook_io.read_notebook(tmp_path / "ours.ipynb") == notebook
 

@@ -27,7 +27,7 @@ from lqe_helpers.authoring import files, handout_pages, handouts
 from lqe_helpers.authoring.errors import OutputFolderError, OutputWriteError
 from lqe_helpers.authoring.manifest import MANIFEST_NAME
 from lqe_helpers.authoring.notebook_io import read_notebook
-from lqe_helpers.authoring.student_edition import EXPLORER_TAG
+from lqe_helpers.authoring.task_cells import EXPLORER_TAG
 
 NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 REAL = sorted(path.stem for path in NOTEBOOKS.glob("*.ipynb"))

@@ -11,7 +11,7 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_outp
 
 from lqe_helpers import checks
 from lqe_helpers.authoring import marking_guide as mg
-from lqe_helpers.authoring import student_edition as se
+from lqe_helpers.authoring import task_cells as tc
 
 ROOT = Path(__file__).resolve().parents[2]
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
@@ -174,10 +174,10 @@ def test_guide_of_the_packs_notebooks(tmp_path):
         assert f"`{path.name}`" in text
         for cell in notebook.cells:
             tags = cell.metadata.get("tags", [])
-            if se.SOLUTION_TAG in tags:
-                first = se.task_instruction(cell.source)[0].removeprefix(se.TASK_PREFIX).strip()
+            if tc.SOLUTION_TAG in tags:
+                first = tc.task_instruction(cell.source)[0].removeprefix(tc.TASK_PREFIX).strip()
                 assert f"#### Task: {first}" in text
-            if se.ANSWER_TAG in tags:
+            if tc.ANSWER_TAG in tags:
                 heading = " ".join(line.lstrip("#").strip()
-                                   for line in se.answer_headings(cell.source))
+                                   for line in tc.answer_headings(cell.source))
                 assert f"#### Written answer: {heading or '(no heading)'}" in text

@@ -18,7 +18,7 @@ import nbformat
 import pytest
 from nbformat.v4 import new_code_cell, new_notebook
 
-from lqe_helpers.authoring import files, notebook_runner
+from lqe_helpers.authoring import execution, files, notebook_runner
 
 KERNELSPEC = {"name": "python3", "display_name": "Python 3 (ipykernel)", "language": "python"}
 
@@ -217,7 +217,7 @@ def test_notebooks_are_saved_together_and_unchanged_ones_not_rewritten(tmp_path,
 @pytest.mark.kernel
 def test_allow_errors_keeps_the_error_in_the_outputs(tmp_path):
     path = write(tmp_path / "errors.ipynb", "1 / 0", "print('still runs')")
-    notebook = notebook_runner.execute_notebook(path, allow_errors=True)
+    notebook = execution.execute_notebook(path, allow_errors=True)
     [error] = notebook.cells[0].outputs
     assert error["output_type"] == "error"
     assert error["ename"] == "ZeroDivisionError"
@@ -234,7 +234,7 @@ def test_a_stream_is_one_output_however_the_kernel_chunked_it(tmp_path):
               "print('second', flush=True)\n"
               "sys.stderr.write('warning\\n')\n"
               "print('third')")
-    notebook = notebook_runner.execute_notebook(write(tmp_path / "chunks.ipynb", source))
+    notebook = execution.execute_notebook(write(tmp_path / "chunks.ipynb", source))
     streams = {output["name"]: output["text"] for output in notebook.cells[0].outputs}
     assert len(notebook.cells[0].outputs) == 2, notebook.cells[0].outputs
     assert streams == {"stdout": "first\nsecond\nthird\n", "stderr": "warning\n"}
@@ -244,4 +244,4 @@ def test_a_stream_is_one_output_however_the_kernel_chunked_it(tmp_path):
 def test_execute_notebook_refuses_a_bad_timeout(tmp_path, timeout):
     path = write(tmp_path / "a.ipynb", "1")
     with pytest.raises(ValueError, match=r"timeout must be a number of seconds > 0, got "):
-        notebook_runner.execute_notebook(path, timeout=timeout)
+        execution.execute_notebook(path, timeout=timeout)

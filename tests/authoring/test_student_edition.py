@@ -23,8 +23,10 @@ from nbclient import NotebookClient
 from nbclient.exceptions import CellExecutionError
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
+from lqe_helpers.authoring import errors, manifest
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
+from lqe_helpers.authoring import task_cells as tc
 
 NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 REAL = sorted(path.name for path in NOTEBOOKS.glob("*.ipynb"))
@@ -86,7 +88,7 @@ def tags(cell: nbformat.NotebookNode) -> list[str]:
 
 
 def is_marked(cell: nbformat.NotebookNode) -> bool:
-    return bool({se.SOLUTION_TAG, se.ANSWER_TAG} & set(tags(cell)))
+    return bool({tc.SOLUTION_TAG, tc.ANSWER_TAG} & set(tags(cell)))
 
 
 def surviving_solution_lines(source: nbformat.NotebookNode,
@@ -99,11 +101,11 @@ def surviving_solution_lines(source: nbformat.NotebookNode,
     marked, other = set(), set()
     for cell in source.cells:
         lines = cell.source.splitlines()
-        if se.SOLUTION_TAG in tags(cell):  # the stub keeps the task and def signatures
-            kept = set(se.stub_source(cell.source).splitlines())
+        if tc.SOLUTION_TAG in tags(cell):  # the stub keeps the task and def signatures
+            kept = set(tc.stub_source(cell.source).splitlines())
             lines = [line for line in lines if line not in kept]
-        elif se.ANSWER_TAG in tags(cell):
-            lines = [line for line in lines if line not in se.answer_headings(cell.source)]
+        elif tc.ANSWER_TAG in tags(cell):
+            lines = [line for line in lines if line not in tc.answer_headings(cell.source)]
         (marked if is_marked(cell) else other).update(
             line.strip() for line in lines if line.strip())
     student_lines = {line.strip() for cell in student.cells for line in cell.source.splitlines()}
@@ -121,8 +123,8 @@ def surviving_answer_text(source: nbformat.NotebookNode,
     """Runs of eight words of an answer body (and nowhere else in ``source``) in ``student``."""
     answers, other = set(), set()
     for cell in source.cells:
-        if se.ANSWER_TAG in tags(cell):
-            headings = se.answer_headings(cell.source)
+        if tc.ANSWER_TAG in tags(cell):
+            headings = tc.answer_headings(cell.source)
             answers |= shingles("\n".join(line for line in cell.source.splitlines()
                                           if line not in headings))
         else:
@@ -141,9 +143,9 @@ def assert_nothing_marked_survives(source: nbformat.NotebookNode,
         assert cell.get("execution_count") is None
         assert "attachments" not in cell
     assert "widgets" not in student.metadata
-    assert sum(se.TASK_TAG in tags(cell) for cell in student.cells) == se.count_solutions(source)
-    answers = sum(se.ANSWER_TAG in tags(cell) for cell in source.cells)
-    assert sum(se.ANSWER_PROMPT_TAG in tags(cell) for cell in student.cells) == answers
+    assert sum(tc.TASK_TAG in tags(cell) for cell in student.cells) == se.count_solutions(source)
+    answers = sum(tc.ANSWER_TAG in tags(cell) for cell in source.cells)
+    assert sum(tc.ANSWER_PROMPT_TAG in tags(cell) for cell in student.cells) == answers
     assert not any(is_marked(cell) for cell in student.cells)
 
 
@@ -151,25 +153,25 @@ def assert_nothing_marked_survives(source: nbformat.NotebookNode,
 
 
 def test_task_instruction_is_the_leading_comment_block():
-    assert se.task_instruction(SOLUTION) == SOLUTION.splitlines()[:2]
-    assert se.task_instruction("# Task: one line\nx = 1\n# later comment") == ["# Task: one line"]
+    assert tc.task_instruction(SOLUTION) == SOLUTION.splitlines()[:2]
+    assert tc.task_instruction("# Task: one line\nx = 1\n# later comment") == ["# Task: one line"]
 
 
 @pytest.mark.parametrize("source", ["x = 1", "", "# Note: not a task\nx = 1", "\n# Task: late"])
 def test_task_instruction_rejects_a_cell_without_task(source):
     with pytest.raises(ValueError, match="# Task:"):
-        se.task_instruction(source)
+        tc.task_instruction(source)
 
 
 def test_stub_is_task_then_raise():
-    stub = se.stub_source(SOLUTION)
+    stub = tc.stub_source(SOLUTION)
     assert stub.splitlines() == [*SOLUTION.splitlines()[:2],
-                                 f'raise NotImplementedError("{se.STUB_MESSAGE}")']
+                                 f'raise NotImplementedError("{tc.STUB_MESSAGE}")']
     with pytest.raises(NotImplementedError, match="task described above"):
         exec(compile(stub, "<stub>", "exec"), {})
 
 
-RAISE = f'raise NotImplementedError("{se.STUB_MESSAGE}")'
+RAISE = f'raise NotImplementedError("{tc.STUB_MESSAGE}")'
 FUNCTION_TASK = '''# Task: write my_filter(y, A, C, Q, R, z0, P0) -> estimates (n, k): eq. (5).
 #       y has shape (k, m).
 @staticmethod
@@ -197,7 +199,7 @@ estimates = my_filter(1, 2, 3, 4, 5)  # the worked call
 
 
 def test_stub_keeps_signatures_and_docstrings_and_raises_for_the_rest():
-    stub = se.stub_source(FUNCTION_TASK)
+    stub = tc.stub_source(FUNCTION_TASK)
     assert stub.splitlines() == [
         *FUNCTION_TASK.splitlines()[:2],
         "@staticmethod",
@@ -224,7 +226,7 @@ def test_stub_keeps_signatures_and_docstrings_and_raises_for_the_rest():
 
 def test_a_cell_of_functions_only_runs_and_its_functions_say_not_written():
     source = "# Task: write twice(x) -> 2 x.\ndef twice(x):\n    # double it\n    return 2 * x\n"
-    stub = se.stub_source(source)
+    stub = tc.stub_source(source)
     assert stub == f"# Task: write twice(x) -> 2 x.\ndef twice(x):\n    {RAISE}"
     namespace: dict = {}
     exec(compile(stub, "<stub>", "exec"), namespace)  # defining it raises nothing
@@ -234,13 +236,13 @@ def test_a_cell_of_functions_only_runs_and_its_functions_say_not_written():
 
 @pytest.mark.parametrize("code", ["%timeit x = 1", "x = (", "if True:\n    def f():\n  pass"])
 def test_unparsable_or_magic_code_is_stubbed_whole(code):
-    assert se.stub_source(f"# Task: do it.\n{code}") == f"# Task: do it.\n{RAISE}"
+    assert tc.stub_source(f"# Task: do it.\n{code}") == f"# Task: do it.\n{RAISE}"
 
 
 def test_allowed_tags_are_defined_once():
-    assert se.ALLOWED_TAGS == {"solution", "answer", "explorer", "nbval-ignore-output"}
-    assert {se.SOLUTION_TAG, se.ANSWER_TAG, se.EXPLORER_TAG,
-            se.IGNORE_OUTPUT_TAG} == se.ALLOWED_TAGS
+    assert tc.ALLOWED_TAGS == {"solution", "answer", "explorer", "nbval-ignore-output"}
+    assert {tc.SOLUTION_TAG, tc.ANSWER_TAG, tc.EXPLORER_TAG,
+            tc.IGNORE_OUTPUT_TAG} == tc.ALLOWED_TAGS
 
 
 @pytest.mark.parametrize(
@@ -293,15 +295,15 @@ def test_the_pack_metadata_is_kept():
 @pytest.mark.parametrize(
     ("source", "prompt"),
     [
-        ("Plain answer.", [se.ANSWER_PROMPT]),
+        ("Plain answer.", [tc.ANSWER_PROMPT]),
         ("## The answers\n\n### (a)\n**1.** Yes.\n# not a heading any more",
-         ["## The answers", "### (a)", se.ANSWER_PROMPT]),
-        ("\n## Late heading\nText", ["## Late heading", se.ANSWER_PROMPT]),
-        ("Text first\n## Heading after text", [se.ANSWER_PROMPT]),
+         ["## The answers", "### (a)", tc.ANSWER_PROMPT]),
+        ("\n## Late heading\nText", ["## Late heading", tc.ANSWER_PROMPT]),
+        ("Text first\n## Heading after text", [tc.ANSWER_PROMPT]),
     ],
 )
 def test_answer_prompt_keeps_only_the_leading_headings(source, prompt):
-    assert se.prompt_source(source) == "\n\n".join(prompt)
+    assert tc.prompt_source(source) == "\n\n".join(prompt)
 
 
 def test_student_edition_of_fixture(tmp_path):
@@ -318,10 +320,10 @@ def test_student_edition_of_fixture(tmp_path):
     assert len(student.cells) == len(original.cells)
     by_tag = {tuple(tags(cell)): cell for cell in student.cells}
 
-    stubs = [cell for cell in student.cells if se.TASK_TAG in tags(cell)]
-    assert [cell.source for cell in stubs] == [se.stub_source(SOLUTION),
-                                               se.stub_source(SECOND_SOLUTION)]
-    assert by_tag[(se.ANSWER_PROMPT_TAG,)].source == f"### Answer to (a)\n\n{se.ANSWER_PROMPT}"
+    stubs = [cell for cell in student.cells if tc.TASK_TAG in tags(cell)]
+    assert [cell.source for cell in stubs] == [tc.stub_source(SOLUTION),
+                                               tc.stub_source(SECOND_SOLUTION)]
+    assert by_tag[(tc.ANSWER_PROMPT_TAG,)].source == f"### Answer to (a)\n\n{tc.ANSWER_PROMPT}"
     assert by_tag[("explorer", "nbval-ignore-output")].source == EXPLORER
     for kept, before in zip(student.cells, original.cells, strict=True):
         if not is_marked(before):
@@ -445,7 +447,7 @@ class StudentRun:
                                 resources=resources)
         code = [i for i, cell in enumerate(self.notebook.cells) if cell.cell_type == "code"]
         explorers = [i for i, cell in enumerate(self.notebook.cells)
-                     if se.EXPLORER_TAG in tags(cell)]
+                     if tc.EXPLORER_TAG in tags(cell)]
         with client.setup_kernel():
             for index in code:
                 error = run_cell(client, self.notebook.cells[index], index)
@@ -471,18 +473,18 @@ class StudentRun:
 
 
 def assert_runs_until_first_stub(run: StudentRun) -> None:
-    stubs = [i for i, cell in enumerate(run.notebook.cells) if se.TASK_TAG in tags(cell)]
+    stubs = [i for i, cell in enumerate(run.notebook.cells) if tc.TASK_TAG in tags(cell)]
     if not stubs:
         assert run.stopped_at is None, run.stop_error
         return
-    if run.stopped_at == stubs[0] + 1 and se.CHECK_CALL in run.notebook.cells[
+    if run.stopped_at == stubs[0] + 1 and tc.CHECK_CALL in run.notebook.cells[
             run.stopped_at].source:
         # A stub of functions only runs; the check after it (a CheckFailed) says so.
         assert "not written yet" in run.stop_error.evalue, run.stop_error.evalue
     else:
         assert run.stopped_at == stubs[0], run.stop_error
         assert run.stop_error.ename == "NotImplementedError"
-        assert se.STUB_MESSAGE in run.stop_error.evalue
+        assert tc.STUB_MESSAGE in run.stop_error.evalue
     for cell in run.notebook.cells[: stubs[0]]:
         for output in cell.get("outputs", []):
             assert output.output_type != "error"
@@ -491,7 +493,7 @@ def assert_runs_until_first_stub(run: StudentRun) -> None:
 
 def assert_explorers_work(run: StudentRun) -> None:
     assert run.explorer_errors == {}
-    explorers = [i for i, cell in enumerate(run.notebook.cells) if se.EXPLORER_TAG in tags(cell)]
+    explorers = [i for i, cell in enumerate(run.notebook.cells) if tc.EXPLORER_TAG in tags(cell)]
     assert sorted(run.fresh_explorers) == explorers
     for cell in [run.notebook.cells[i] for i in explorers] + list(run.fresh_explorers.values()):
         shown = [output.data for output in cell.outputs if "data" in output]
@@ -553,19 +555,19 @@ def test_source_follows_the_tag_convention(sources, key, name):
     for index, cell in enumerate(notebook.cells):
         cell_tags = set(tags(cell))
         where = f"{name}, cell {index}"
-        if se.SOLUTION_TAG in cell_tags:
+        if tc.SOLUTION_TAG in cell_tags:
             assert cell.cell_type == "code", where
-            instruction = " ".join(se.task_instruction(cell.source))
+            instruction = " ".join(tc.task_instruction(cell.source))
             assert len(instruction.split()) >= 4, f"{where}: the task needs a real instruction"
-            assert len(se.task_instruction(cell.source)) < len(cell.source.splitlines()), where
+            assert len(tc.task_instruction(cell.source)) < len(cell.source.splitlines()), where
             # nbval must check worked solutions like any other cell.
             assert not cell_tags & UNCHECKED_TAGS, f"{where}: {cell_tags & UNCHECKED_TAGS}"
-        if se.ANSWER_TAG in cell_tags:
+        if tc.ANSWER_TAG in cell_tags:
             assert cell.cell_type == "markdown", where
-        if se.EXPLORER_TAG in cell_tags:
+        if tc.EXPLORER_TAG in cell_tags:
             assert cell.cell_type == "code", where
             assert "nbval-ignore-output" in cell_tags, where
-            assert not cell_tags & {se.SOLUTION_TAG, se.ANSWER_TAG}, where
+            assert not cell_tags & {tc.SOLUTION_TAG, tc.ANSWER_TAG}, where
 
 
 @pytest.mark.parametrize(("key", "name"), CASES, ids=IDS)
@@ -605,7 +607,7 @@ def filled_fixture(source: nbformat.NotebookNode) -> nbformat.NotebookNode:
 def check_cells(notebook: nbformat.NotebookNode) -> list[int]:
     """Indices of the check cells: the untagged code cell right after each task."""
     return [index + 1 for index, cell in enumerate(notebook.cells[:-1])
-            if se.TASK_TAG in tags(cell) and se.CHECK_CALL in notebook.cells[index + 1].source
+            if tc.TASK_TAG in tags(cell) and tc.CHECK_CALL in notebook.cells[index + 1].source
             and not tags(notebook.cells[index + 1])]
 
 
@@ -697,7 +699,7 @@ def test_file_safety_bad_folders_are_refused(tmp_path):
                          (tmp_path / "src" / "student", "lies inside the source folder"),
                          (tmp_path, "contains the source folder"),
                          (tmp_path / "file", "is a file; give a folder")]:
-        with pytest.raises(se.OutputFolderError, match=message):
+        with pytest.raises(errors.OutputFolderError, match=message):
             se.build_student_edition(tmp_path / "src", out)
     assert _snapshot(tmp_path) == before
 
@@ -729,13 +731,13 @@ def test_file_safety_grading_notes_and_foreign_notebooks_are_never_touched(tmp_p
     assert written == [out / "01_fixture.ipynb"]
     assert {name: (out / name).read_text() for name in mine} == mine
     assert sorted(path.relative_to(out).as_posix() for path in out.rglob("*") if path.is_file()
-                  ) == sorted([*mine, "01_fixture.ipynb", se.MANIFEST_NAME])
+                  ) == sorted([*mine, "01_fixture.ipynb", manifest.MANIFEST_NAME])
     # A notebook of the instructor's in the way of the build stops it; nothing changes.
     (out / "01_fixture.ipynb").unlink()
     (tmp_path / "src" / "my_grading_notes.ipynb").write_bytes(
         (tmp_path / "src" / "01_fixture.ipynb").read_bytes())
     before = _snapshot(out)
-    with pytest.raises(se.OutputFolderError,
+    with pytest.raises(errors.OutputFolderError,
                        match=r"my_grading_notes\.ipynb was not written by student_edition"):
         se.build_student_edition(tmp_path / "src", out)
     assert _snapshot(out) == before
@@ -751,7 +753,7 @@ def test_file_safety_a_renamed_notebooks_old_edition_goes_a_hand_edited_one_stay
     (tmp_path / "src" / "02_other.ipynb").rename(tmp_path / "src" / "03_other.ipynb")
     se.build_student_edition(tmp_path / "src", out)
     assert sorted(path.name for path in out.iterdir()) == [
-        se.MANIFEST_NAME, "01_new_name.ipynb", "02_other.ipynb", "03_other.ipynb"]
+        manifest.MANIFEST_NAME, "01_new_name.ipynb", "02_other.ipynb", "03_other.ipynb"]
     assert (out / "02_other.ipynb").read_text() == "edited by the instructor after the build"
 
 
@@ -763,7 +765,7 @@ def test_file_safety_a_symlink_in_out_is_not_written_through(tmp_path):
     out.mkdir()
     (out / "01_worked.ipynb").symlink_to(worked)
     before, course_before = _snapshot(out), _snapshot(course)
-    with pytest.raises(se.OutputFolderError, match=r"01_worked\.ipynb is a symbolic link"):
+    with pytest.raises(errors.OutputFolderError, match=r"01_worked\.ipynb is a symbolic link"):
         se.build_student_edition(course, out)
     assert _snapshot(out) == before
     assert _snapshot(course) == course_before
@@ -789,7 +791,7 @@ def test_file_safety_a_failure_while_writing_changes_nothing(tmp_path, monkeypat
         real(fd, data)
 
     monkeypatch.setattr(files, "_write_fd", full_disk)
-    with pytest.raises(se.OutputWriteError, match="No space left on device"):
+    with pytest.raises(errors.OutputWriteError, match="No space left on device"):
         se.build_student_edition(tmp_path / "src", out)
     assert _snapshot(tmp_path) == before
 

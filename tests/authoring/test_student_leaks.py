@@ -57,6 +57,7 @@ from artefacts import StudentEdition, StudentPack
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook, new_output
 
 from lqe_helpers.authoring import student_edition as se
+from lqe_helpers.authoring import task_cells as tc
 
 NOTEBOOK_DIR = Path(__file__).resolve().parents[2] / "notebooks"
 NOTEBOOKS = sorted(NOTEBOOK_DIR.glob("*.ipynb"))
@@ -135,7 +136,7 @@ def code_literals(notebook: nbformat.NotebookNode) -> set[Decimal]:
     """Values of the number literals typed in solution cells' code (inputs, not results)."""
     found = set()
     for cell in notebook.cells:
-        if se.SOLUTION_TAG not in tags(cell):
+        if tc.SOLUTION_TAG not in tags(cell):
             continue
         try:
             tokens = list(tokenize.generate_tokens(io.StringIO(cell.source + "\n").readline))
@@ -152,11 +153,11 @@ def printed_results(notebook: nbformat.NotebookNode) -> dict[Decimal, str]:
     allowed |= code_literals(notebook)
     found: dict[Decimal, str] = {}
     for index, cell in enumerate(notebook.cells):
-        if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+        if cell.cell_type != "code" or tc.EXPLORER_TAG in tags(cell):
             continue
         for output in cell.get("outputs", []):
             for value in results(output_text(output)) - allowed:
-                found.setdefault(value, se.cell_place("source", index, cell))
+                found.setdefault(value, tc.cell_place("source", index, cell))
     return found
 
 
@@ -190,12 +191,12 @@ def answer_sentences(notebook: nbformat.NotebookNode) -> dict[str, str]:
     """Sentences of the worked answers: sentence → the answer cell it comes from."""
     found: dict[str, str] = {}
     for index, cell in enumerate(notebook.cells):
-        if se.ANSWER_TAG in tags(cell):
-            headings = se.answer_headings(cell.source)
+        if tc.ANSWER_TAG in tags(cell):
+            headings = tc.answer_headings(cell.source)
             body = "\n".join(line for line in cell.source.splitlines()
                              if line.rstrip() not in headings)
             for sentence in sentences(body):
-                found.setdefault(sentence, se.cell_place("source", index, cell))
+                found.setdefault(sentence, tc.cell_place("source", index, cell))
     return found
 
 
@@ -204,7 +205,7 @@ def answer_sentences(notebook: nbformat.NotebookNode) -> dict[str, str]:
 
 def student_cells(student: nbformat.NotebookNode) -> list[tuple[str, str]]:
     """(place, text) of every cell of the student edition: its source and its outputs."""
-    return [(se.cell_place("student", index, cell),
+    return [(tc.cell_place("student", index, cell),
              "\n".join([cell.source, *(output_text(o) for o in cell.get("outputs", []))]))
             for index, cell in enumerate(student.cells)]
 
@@ -239,7 +240,7 @@ def printed_before_the_tasks(notebook: nbformat.NotebookNode) -> list[str]:
     allowed = {number_value(token) for token in numbers(question_text(notebook))}
     allowed |= code_literals(notebook)
     first_task = next((index for index, cell in enumerate(notebook.cells)
-                       if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
+                       if tc.SOLUTION_TAG in tags(cell)), len(notebook.cells))
     core_end = next((index for index, cell in enumerate(notebook.cells)
                      if cell.cell_type == "markdown"
                      and re.search(r"^##\s+Going further", cell.source, re.M | re.I)),
@@ -247,17 +248,17 @@ def printed_before_the_tasks(notebook: nbformat.NotebookNode) -> list[str]:
     early: dict[Decimal, str] = {}
     leaks = []
     for index, cell in enumerate(notebook.cells[:core_end]):
-        if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+        if cell.cell_type != "code" or tc.EXPLORER_TAG in tags(cell):
             continue
         values = set()
         for output in cell.get("outputs", []):
             values |= results(output_text(output)) - allowed
         if index < first_task:
             for value in values:
-                early.setdefault(value, se.cell_place("source", index, cell))
+                early.setdefault(value, tc.cell_place("source", index, cell))
         else:
             leaks += [f"{early[value]} prints {value} before the tasks; "
-                      f"{se.cell_place('source', index, cell)} computes it"
+                      f"{tc.cell_place('source', index, cell)} computes it"
                       for value in sorted(values & set(early))]
             for value in values & set(early):
                 del early[value]
@@ -277,7 +278,7 @@ def set_up_leaks(paths: list[Path]) -> list[str]:
         allowed = {number_value(token) for token in numbers(question_text(notebook))}
         allowed |= code_literals(notebook)
         first_task = next((index for index, cell in enumerate(notebook.cells)
-                           if se.SOLUTION_TAG in tags(cell)), len(notebook.cells))
+                           if tc.SOLUTION_TAG in tags(cell)), len(notebook.cells))
         core_end = next((index for index, cell in enumerate(notebook.cells)
                          if cell.cell_type == "markdown"
                          and re.search(r"^##\s+Going further", cell.source, re.M | re.I)),
@@ -285,12 +286,12 @@ def set_up_leaks(paths: list[Path]) -> list[str]:
         early: dict[Decimal, str] = {}
         core: dict[Decimal, str] = {}
         for index, cell in enumerate(notebook.cells[:core_end]):
-            if cell.cell_type != "code" or se.EXPLORER_TAG in tags(cell):
+            if cell.cell_type != "code" or tc.EXPLORER_TAG in tags(cell):
                 continue
             for output in cell.get("outputs", []):
                 for value in results(output_text(output)) - allowed:
                     (early if index < first_task else core).setdefault(
-                        value, se.cell_place("source", index, cell))
+                        value, tc.cell_place("source", index, cell))
         return early, core, allowed
 
     parts = {path.stem: split(nbformat.read(path, as_version=4)) for path in paths}
@@ -316,7 +317,7 @@ def test_a_set_up_printing_another_notebooks_result_is_found(tmp_path):
     nbformat.write(later, tmp_path / "01_fixture.ipynb")
     leaks = set_up_leaks([tmp_path / "00_fixture.ipynb", tmp_path / "01_fixture.ipynb"])
     assert [leak.split(";")[0] for leak in leaks] == [
-        f"01_fixture {se.cell_place('source', 1, setup)} prints 1396 before its tasks"]
+        f"01_fixture {tc.cell_place('source', 1, setup)} prints 1396 before its tasks"]
 
 
 def test_no_set_up_prints_a_result_another_notebooks_core_tasks_compute():
@@ -372,7 +373,7 @@ def test_sentences_ignore_markdown_questions_and_short_ones():
 
 def test_a_clean_student_edition_has_no_leak():
     notebook = leak_fixture(new_markdown_cell("## Summary\n\nDoes filtering help, and why?"))
-    assert printed_results(notebook) == {Decimal("1.259"): se.cell_place("source", 2,
+    assert printed_results(notebook) == {Decimal("1.259"): tc.cell_place("source", 2,
                                                                          notebook.cells[2])}
     assert find_leaks(notebook, student_of(notebook, "clean")) == []
 
@@ -410,8 +411,8 @@ def test_a_result_a_given_cell_prints_for_a_task_leaks_too():
                                               text="mean MSE 2.3456 cm²\n")])
     notebook = leak_fixture(given, new_markdown_cell("## Summary\n\nWhy is it 2.3456 cm²?"))
     leaks = find_leaks(notebook, student_of(notebook, "given"))
-    assert leaks == [f"{se.cell_place('student', 6, notebook.cells[5])} contains 2.3456, "
-                     f"printed by {se.cell_place('source', 4, notebook.cells[4])}"]
+    assert leaks == [f"{tc.cell_place('student', 6, notebook.cells[5])} contains 2.3456, "
+                     f"printed by {tc.cell_place('source', 4, notebook.cells[4])}"]
 
 
 def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
@@ -419,8 +420,8 @@ def test_a_number_in_a_task_comment_leaks_and_one_from_the_question_does_not():
         "# Task: check that your MSE is 1.259 cm² and below 6.21 cm².\nx = 1",
         metadata={"tags": ["solution"]}))
     leaks = find_leaks(notebook, student_of(notebook, "task"))
-    assert leaks == [f"{se.cell_place('student', 5, notebook.cells[4])} contains 1.259, "
-                     f"printed by {se.cell_place('source', 2, notebook.cells[2])}"]
+    assert leaks == [f"{tc.cell_place('student', 5, notebook.cells[4])} contains 1.259, "
+                     f"printed by {tc.cell_place('source', 2, notebook.cells[2])}"]
 
 
 # ------------------------------------------------------------- the pack's notebooks
@@ -445,8 +446,8 @@ def test_a_given_cell_that_prints_a_tasks_result_before_it_is_found():
     notebook = leak_fixture()
     notebook.cells.insert(1, table)
     assert printed_before_the_tasks(notebook) == [
-        f"{se.cell_place('source', 1, table)} prints 1.259 before the tasks; "
-        f"{se.cell_place('source', 3, notebook.cells[3])} computes it"]
+        f"{tc.cell_place('source', 1, table)} prints 1.259 before the tasks; "
+        f"{tc.cell_place('source', 3, notebook.cells[3])} computes it"]
     assert printed_before_the_tasks(leak_fixture()) == []
 
 

@@ -29,6 +29,7 @@ from once_per_run import writable_copy
 
 from lqe_helpers.authoring import student_edition as se
 from lqe_helpers.authoring import student_pack as sp
+from lqe_helpers.authoring import task_cells as tc
 from lqe_helpers.authoring.errors import OutputFolderError
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -110,7 +111,7 @@ def test_pack_makefile_refuses_a_makefile_it_cannot_keep_lab_from(text, message)
 #: What no test shipped to students may import or read: the oracle loops, the checks'
 #: worked and wrong answers, the instructor's tools, the worked notebooks, the suite's
 #: shared builds.
-INSTRUCTOR_ONLY = re.compile(r"reference_loops|check_outcomes|lqe_helpers\.authoring"
+INSTRUCTOR_ONLY = re.compile(r"reference_loops|check_outcomes|lqe_helpers\.(authoring|grading)"
                              r"|from lqe_helpers import authoring|[\"']notebooks[\"']"
                              r"|(?:from|import) (?:artefacts|once_per_run|make_env)\b"
                              r"|[\"']artefacts[\"']")
@@ -150,7 +151,8 @@ def test_the_pack_holds_what_a_student_needs_and_nothing_of_the_instructor(pack)
                    "lqe_helpers/explorers/__init__.py", "tests/conftest.py",
                    f"tests/{sp.STRUCTURE_TEST}", f"tests/{sp.CONVENTIONS_NAME}"):
         assert needed in inside, needed
-    assert not [name for name in inside if name.startswith("lqe_helpers/authoring")]
+    assert not [name for name in inside if name.startswith(("lqe_helpers/authoring",
+                                                            "lqe_helpers/grading"))]
     assert not [name for name in inside if "__pycache__" in name or name.endswith(".pyc")]
     assert not [name for name in inside if "marking" in name]
     assert {name for name in inside if name.startswith("tests/")} == {
@@ -165,7 +167,7 @@ def test_the_notebooks_are_the_student_edition(pack, path):
     _, folder = pack
     packed = (folder / "notebooks" / path.name).read_text("utf-8")
     assert packed == se.student_edition(nbformat.read(path, as_version=4), path.stem)
-    assert not any(se.SOLUTION_TAG in cell.metadata.get("tags", []) or cell.get("outputs")
+    assert not any(tc.SOLUTION_TAG in cell.metadata.get("tags", []) or cell.get("outputs")
                    for cell in nbformat.reads(packed, as_version=4).cells)
 
 
@@ -230,9 +232,9 @@ def test_the_packs_structure_tests_can_fail(pack, tmp_path):
     path = copy / "notebooks" / name
     notebook = nbformat.read(path, as_version=4)
     first_task = next(i for i, cell in enumerate(notebook.cells)
-                      if se.TASK_TAG in cell.metadata.get("tags", []))
+                      if tc.TASK_TAG in cell.metadata.get("tags", []))
     notebook.cells[first_task].metadata["tags"] = ["solution"]
-    kept = [cell for cell in notebook.cells if se.CHECK_CALL not in cell.source]
+    kept = [cell for cell in notebook.cells if tc.CHECK_CALL not in cell.source]
     notebook.cells = kept
     nbformat.write(notebook, path)
     result = subprocess.run([sys.executable, "-m", "pytest", f"tests/{sp.STRUCTURE_TEST}",

@@ -30,7 +30,7 @@ from lqe_helpers.authoring.notebook_io import read_notebook
 from lqe_helpers.authoring.output_folder import write_output_folder
 
 
-def fake_execute(path, timeout=None, kernel_name="python3", *, allow_errors=False):
+def fake_execute(path, timeout=None, *, allow_errors=False):
     """handouts' notebooks 'executed' without a kernel: their saved outputs, as read."""
     return read_notebook(path)
 

@@ -1,7 +1,7 @@
 """What is graded in a worked notebook, and for how many points.
 
-One rule for both grading routes (:mod:`~lqe_helpers.authoring.nbgrader_course` and
-:mod:`~lqe_helpers.authoring.grade`) and the marking guide. Only the core path is graded
+One rule for the marking guide and both grading routes (:mod:`lqe_helpers.grading`, which
+imports it from here: nothing in authoring imports grading). Only the core path is graded
 (the cells before ``## Going further``, which is optional and carries no points). A
 question's marks (the tutorial's, :data:`~lqe_helpers.authoring.marking_guide.QUESTION_MARKS`)
 are split: :data:`ANSWER_SHARE` of them go to its written answers (``answer`` cells,
@@ -30,19 +30,6 @@ from lqe_helpers.authoring.task_cells import (
 ANSWER_SHARE = Fraction(2, 5)
 #: The check function a check cell calls (its name is the cell's grade id).
 CHECK_NAME = re.compile(r"\bchecks\.(check_\w+)\s*\(")
-#: The tutorial's question of each graded notebook, by its number.
-QUESTION_LABELS = {"01": "(a)", "02": "(b)", "03": "(c)", "04": "(d)", "05": "(e)"}
-#: The folder where a check saves a student's function for later notebooks
-#: (``student_code.SAVE_FOLDER``: 01 saves ``my_filter``, which 02–05 load). Grading makes it
-#: anew from the submission's own notebooks; a submitted or instructor's copy is never used.
-SAVED_FUNCTIONS = "my_functions"
-#: The call by which a notebook saves a student's function for later notebooks.
-SAVE_CALL = "student_code.save("
-
-
-def question_label(notebook_name: str) -> str:
-    """``(a)`` for ``01_vision_only…``; the notebook's name if it answers no question."""
-    return QUESTION_LABELS.get(notebook_name[:2], notebook_name)
 
 
 @dataclass(frozen=True)
@@ -73,13 +60,6 @@ def core_end(notebook: nbformat.NotebookNode) -> int:
     return next((index for index, cell in enumerate(notebook.cells)
                  if cell.cell_type == "markdown"
                  and cell.source.lstrip().startswith(GOING_FURTHER)), len(notebook.cells))
-
-
-def saves_functions(notebook: nbformat.NotebookNode) -> bool:
-    """Whether a worked notebook's core path saves a student's function (into
-    :data:`SAVED_FUNCTIONS`) for the notebooks after it."""
-    return any(cell.cell_type == "code" and SAVE_CALL in cell.source
-               for cell in notebook.cells[:core_end(notebook)])
 
 
 def is_check_cell(cell: nbformat.NotebookNode | None) -> bool:

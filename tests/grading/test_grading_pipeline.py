@@ -35,7 +35,7 @@ from grading_submissions import (
     submission,
 )
 
-from lqe_helpers.authoring import grade, grading, nbgrader_course
+from lqe_helpers.grading import grade, nbgrader_course, rules
 
 pytestmark = [pytest.mark.slow, pytest.mark.kernel]
 
@@ -48,7 +48,7 @@ EXTRA = {"worked": lambda: WORKED.read_text(encoding="utf-8"),
 PASSES = {**{student: expected for student, (_, expected) in SUBMISSIONS.items()},
           **{key: {"check_filter": True, "check_vision_trial": True} for key in EXTRA}}
 #: The assignment's notebooks (make nbgrader's default: 01–05) and the question of each.
-ASSIGNMENT = {path.name: grading.question_label(path.name) for path in
+ASSIGNMENT = {path.name: rules.question_label(path.name) for path in
               sorted(WORKED.parent.glob("0[1-5]_*.ipynb"))}
 #: Later notebooks submitted filled as the worked ones, and their expected automatic points:
 #: ``filled`` the whole assignment; ``wrong`` (its my_filter fails 01's check, so 01 saves
@@ -57,7 +57,7 @@ LATER = {"filled": {"02_initial_covariance.ipynb": 9, "03_fusion.ipynb": 15,
                     "04_noisier_proprioception.ipynb": 9, "05_sensory_delay.ipynb": 18},
          "wrong": {"05_sensory_delay.ipynb": 12}}
 #: What ``wrong`` also submits: a worked my_filter.py (stale, or a friend's), not to be used.
-SAVED = WORKED.parent / grading.SAVED_FUNCTIONS
+SAVED = WORKED.parent / rules.SAVED_FUNCTIONS
 
 
 def nbgrader(course: Path, *args: str) -> subprocess.CompletedProcess:
@@ -100,7 +100,7 @@ def graded(tmp_path_factory: pytest.TempPathFactory) -> dict:
         (plain / student / NAME).write_bytes(data)
     tool_start = time.monotonic()  # the grade tool on one core, nbgrader on the other
     tool = subprocess.Popen(
-        [sys.executable, "-m", "lqe_helpers.authoring.grade", str(plain), "--out",
+        [sys.executable, "-m", "lqe_helpers.grading.grade", str(plain), "--out",
          str(base / "grades"), "--source", str(WORKED.parent), "--jobs", "1",
          "--cell-timeout", str(CELL_TIMEOUT), "--notebook-timeout", "300"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -108,7 +108,7 @@ def graded(tmp_path_factory: pytest.TempPathFactory) -> dict:
         autograde = nbgrader(course, "autograde", "lqe", f"--Execute.timeout={CELL_TIMEOUT}")
         nbgrader_seconds = time.monotonic() - start
         nbgrader(course, "generate_feedback", "lqe")
-        nbgrader(course, "export", "--exporter=lqe_helpers.authoring.nbgrader_export."
+        nbgrader(course, "export", "--exporter=lqe_helpers.grading.nbgrader_export."
                  "QuestionPointsExport", "--to=questions.csv")
         _, stderr = tool.communicate(timeout=900)
     finally:
@@ -270,7 +270,7 @@ def test_grade_tool_rerun_skips_graded_and_regrades_changed(graded: dict,
     (plain / "wrong" / NAME).write_text("[]", "utf-8")  # so is 05, which loads what 01 saves
     (out / "results" / "invalid" / f"{NAME}.json").unlink()  # as if killed before it
     done = subprocess.run(
-        [sys.executable, "-m", "lqe_helpers.authoring.grade", str(plain), "--out", str(out),
+        [sys.executable, "-m", "lqe_helpers.grading.grade", str(plain), "--out", str(out),
          "--source", str(WORKED.parent), "--cell-timeout", str(CELL_TIMEOUT)],
         capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stderr

@@ -1,6 +1,6 @@
 """nbgrader's ``export`` of the LQE course: one row per student, points per question.
 
-``nbgrader export --exporter=lqe_helpers.authoring.nbgrader_export.QuestionPointsExport
+``nbgrader export --exporter=lqe_helpers.grading.nbgrader_export.QuestionPointsExport
 [--to grades.csv]`` (needs the ``grading`` extra). Columns: ``student``, then for each
 notebook of each assignment ``(a) automatic`` (points of its check cells, as autograded)
 and ``(a) by hand`` (its written answers once marked; empty until then); a notebook a
@@ -16,7 +16,7 @@ from nbgrader.api import Gradebook, MissingEntry
 from nbgrader.plugins import ExportPlugin
 
 from lqe_helpers.authoring.files import atomic_write_text
-from lqe_helpers.authoring.grading import question_label
+from lqe_helpers.grading.rules import question_label
 
 
 class QuestionPointsExport(ExportPlugin):

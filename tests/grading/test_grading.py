@@ -12,17 +12,18 @@ import nbformat
 import pytest
 from grading_submissions import NAME, WORKED, WRONG_FILTER, edition, endless_loop, raises_first
 
-from lqe_helpers.authoring import grade, grading, nbgrader_course
+from lqe_helpers.authoring import points
 from lqe_helpers.authoring.marking_guide import QUESTION_MARKS, question_and_marks
 from lqe_helpers.authoring.student_edition import student_edition
 from lqe_helpers.authoring.task_cells import stub_source
+from lqe_helpers.grading import grade, nbgrader_course, rules
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[2] / "notebooks").glob("*.ipynb"))
 
 
-def plan(path: Path) -> list[grading.GradedCell]:
+def plan(path: Path) -> list[points.GradedCell]:
     notebook = nbformat.read(path, as_version=4)
-    return grading.graded_cells(notebook, question_and_marks(notebook, path.name)[1])
+    return points.graded_cells(notebook, question_and_marks(notebook, path.name)[1])
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
@@ -46,7 +47,7 @@ def test_points_of_01() -> None:
 
 def test_points_refuse_bad_marks() -> None:
     with pytest.raises(ValueError, match=r"marks must be >= 0, got -1"):
-        grading.graded_cells(nbformat.read(WORKED, as_version=4), -1)
+        points.graded_cells(nbformat.read(WORKED, as_version=4), -1)
 
 
 def clear_solutions(source: str) -> str:
@@ -142,7 +143,7 @@ def test_graded_copy_names_a_deleted_check() -> None:
 @pytest.mark.slow
 def test_grade_tool_refuses_bad_input_with_one_line(tmp_path: Path) -> None:
     def run(*args: str) -> subprocess.CompletedProcess:
-        return subprocess.run([sys.executable, "-m", "lqe_helpers.authoring.grade", *args],
+        return subprocess.run([sys.executable, "-m", "lqe_helpers.grading.grade", *args],
                               capture_output=True, text=True, timeout=60)
 
     missing = run(str(tmp_path / "nowhere"), "--out", str(tmp_path / "out"))
@@ -240,7 +241,7 @@ def test_grade_tool_gives_a_huge_submission_its_row(tmp_path: Path) -> None:
 
 
 def test_question_labels() -> None:
-    assert [grading.question_label(p.name) for p in NOTEBOOKS] == [
+    assert [rules.question_label(p.name) for p in NOTEBOOKS] == [
         NOTEBOOKS[0].name, "(a)", "(b)", "(c)", "(d)", "(e)", NOTEBOOKS[-1].name]
 
 
@@ -253,15 +254,15 @@ def test_nbgrader_config_ignores_saved_functions() -> None:
 
     config = Config()
     exec(nbgrader_course.CONFIG, {"get_config": lambda: config})  # as nbgrader loads it
-    assert grading.SAVED_FUNCTIONS == student_code.SAVE_FOLDER
+    assert rules.SAVED_FUNCTIONS == student_code.SAVE_FOLDER
     assert config.CourseDirectory.ignore == [".ipynb_checkpoints", "*.pyc", "__pycache__",
-                                             "feedback", grading.SAVED_FUNCTIONS]
+                                             "feedback", rules.SAVED_FUNCTIONS]
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda path: path.stem)
 def test_saves_functions_finds_the_notebooks_that_save(path: Path) -> None:
     """01 saves my_filter and 05 compensate, for the later notebooks (and their explorers)."""
-    saves = grading.saves_functions(nbformat.read(path, as_version=4))
+    saves = rules.saves_functions(nbformat.read(path, as_version=4))
     assert saves == (path.name[:2] in {"01", "05"})
 
 

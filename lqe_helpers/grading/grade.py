@@ -1,6 +1,6 @@
 """Grade a class's submitted notebooks without nbgrader: a grade table and feedback pages.
 
-``python -m lqe_helpers.authoring.grade SUBMISSIONS_DIR --out build/grades [--source notebooks]``
+``python -m lqe_helpers.grading.grade SUBMISSIONS_DIR --out build/grades [--source notebooks]``
 
 ``SUBMISSIONS_DIR`` holds one folder per student with the notebooks they submitted (named
 as the course's, e.g. ``alice/01_vision_only.ipynb``). Each notebook is graded in its own
@@ -13,7 +13,7 @@ grading runs of the student's earlier notebooks saved (02–05 the ``my_filter``
 Only the core path is run (up to ``## Going further``); explorer cells are left out (they
 only draw), and every cell of the worked notebook other than a task (check cells included)
 is restored from ``--source``, so an edited check cannot pass. A check earns its points
-(:mod:`lqe_helpers.authoring.grading`) when it runs without raising.
+(:mod:`lqe_helpers.authoring.points`) when it runs without raising.
 
 Writes, only under ``--out``: ``results/<student>/<notebook>.json`` (one per submission, as
 soon as it is graded, atomically; a rerun skips those whose submission is unchanged, so a
@@ -50,15 +50,9 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.errors import error_line, first_line, shown, strip_colour
     from lqe_helpers.authoring.execution import positive_seconds
     from lqe_helpers.authoring.files import atomic_write_text
-    from lqe_helpers.authoring.grading import (
-        QUESTION_LABELS,
-        SAVED_FUNCTIONS,
-        core_end,
-        graded_cells,
-        saves_functions,
-    )
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import read_notebook, source_notebooks
+    from lqe_helpers.authoring.points import core_end, graded_cells
     from lqe_helpers.authoring.task_cells import (
         EXPLORER_TAG,
         SOLUTION_TAG,
@@ -66,6 +60,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         TASK_TAG,
         cell_tags,
     )
+    from lqe_helpers.grading.rules import QUESTION_LABELS, SAVED_FUNCTIONS, saves_functions
 
 CELL_TIMEOUT, NOTEBOOK_TIMEOUT = 60.0, 600.0
 PASSED = "passed"
@@ -293,7 +288,7 @@ def _run_workers(todo: list, jobs: int, cell_timeout: float, notebook_timeout: f
                 todo.remove(item)
                 path, worked, result_path, digest, functions_from = item
                 _remove_side_files(result_path)
-                command = [sys.executable, "-m", "lqe_helpers.authoring.grade", "--one",
+                command = [sys.executable, "-m", "lqe_helpers.grading.grade", "--one",
                            str(path), "--worked", str(worked), "--result", str(result_path),
                            "--sha256", digest, "--cell-timeout", str(cell_timeout),
                            *(arg for result in functions_from
@@ -397,7 +392,7 @@ def feedback_page(student: str, results: list[tuple[str, dict]]) -> str:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line: grade SUBMISSIONS_DIR into --out (or, with --one, one submission)."""
-    parser = CommandLineParser(prog="python -m lqe_helpers.authoring.grade",
+    parser = CommandLineParser(prog="python -m lqe_helpers.grading.grade",
                                description=__doc__.splitlines()[0])
     parser.add_argument("submissions", type=Path, nargs="?", metavar="SUBMISSIONS_DIR")
     parser.add_argument("--out", type=Path, default=Path("build/grades"))

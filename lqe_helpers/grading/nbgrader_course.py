@@ -1,6 +1,6 @@
 """Write an nbgrader course folder from the worked notebooks.
 
-``python -m lqe_helpers.authoring.nbgrader_course [--source notebooks] [--out build/nbgrader]``
+``python -m lqe_helpers.grading.nbgrader_course [--source notebooks] [--out build/nbgrader]``
 (``make nbgrader``) writes ``source/lqe/<notebook>.ipynb`` for the graded questions
 (01–05, (a)–(e); :data:`GRADED`) and ``nbgrader_config.py``. Each notebook is the core path
 of the worked notebook (``## Going further`` is optional and carries no points: it stays in
@@ -13,7 +13,7 @@ the student pack) with nbgrader cell metadata:
 - an ``answer`` cell becomes a manually graded answer with its points (headings kept);
 - every other cell is read-only.
 
-Points: :mod:`lqe_helpers.authoring.grading`. nbgrader itself is not needed to write the
+Points: :mod:`lqe_helpers.authoring.points`. nbgrader itself is not needed to write the
 folder (``pip install -e '.[grading]'`` to run it). Files are written atomically, only these
 files, only under ``--out``; an ``nbgrader_config.py`` already there is kept (with a warning
 if it differs from the one this tool would write).
@@ -36,9 +36,9 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
     from lqe_helpers.authoring.command_line import CommandLineParser, run_command
     from lqe_helpers.authoring.errors import shown
     from lqe_helpers.authoring.files import atomic_write_text
-    from lqe_helpers.authoring.grading import SAVED_FUNCTIONS, core_end, graded_cells
     from lqe_helpers.authoring.marking_guide import question_and_marks
     from lqe_helpers.authoring.notebook_io import notebook_bytes, read_notebook, source_notebooks
+    from lqe_helpers.authoring.points import core_end, graded_cells
     from lqe_helpers.authoring.task_cells import (
         ANSWER_PROMPT,
         ANSWER_PROMPT_TAG,
@@ -50,6 +50,7 @@ with interrupt_exits_quietly(__name__):  # Ctrl-C while importing: one line
         cell_tags,
         task_instruction,
     )
+    from lqe_helpers.grading.rules import SAVED_FUNCTIONS
 
 #: The nbgrader assignment (and course) name.
 ASSIGNMENT = "lqe"
@@ -67,7 +68,7 @@ GOING_FURTHER_NOTE = ("## Going further\n\nThe optional *Going further* part of 
                       "is in the student pack's edition. It carries no points.")
 
 CONFIG = f'''\
-"""nbgrader configuration of the LQE course (written by lqe_helpers.authoring.nbgrader_course)."""
+"""nbgrader configuration of the LQE course (written by lqe_helpers.grading.nbgrader_course)."""
 import importlib.util
 
 if importlib.util.find_spec("lqe_helpers") is None:  # the kernel must import the pack
@@ -223,7 +224,7 @@ def build_course(source_dir: Path, out_dir: Path,
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Command line: write the nbgrader course folder and list the files written."""
-    parser = CommandLineParser(prog="python -m lqe_helpers.authoring.nbgrader_course",
+    parser = CommandLineParser(prog="python -m lqe_helpers.grading.nbgrader_course",
                                description=__doc__.splitlines()[0])
     parser.add_argument("--source", type=Path, default=Path("notebooks"),
                         help="folder of the worked notebooks (default: notebooks)")
