@@ -71,8 +71,8 @@ class TimeIsUp(BaseException):
         if self.rearm is not None:
             try:
                 self.rearm()
-            except TimeIsUp:  # sent to a worker thread meanwhile: it is sent again
-                pass
+            except BaseException:  # a finalizer cannot raise (Python would only print
+                pass               # "Exception ignored"); a TimeIsUp sent meanwhile comes again
 
 
 class _Stopper:
