@@ -252,6 +252,19 @@ def in_pack(filename: str) -> bool:
     return not filename.startswith("<") and os.path.realpath(filename).startswith(_PACK_FOLDER)
 
 
+#: The methods that make a new object: a message names their class.
+_CONSTRUCTORS = (".__init__", ".__post_init__", ".__new__")
+
+
+def shown_function(name: str) -> str:
+    """A pack function's qualified ``name`` as a message shows it: a constructor as its
+    class ("lqe_helpers.scenario.Scenario (making a new one)")."""
+    for suffix in _CONSTRUCTORS:
+        if name.endswith(suffix):
+            return f"{name.removesuffix(suffix)} (making a new one)"
+    return name
+
+
 def pack_name(frame: types.FrameType) -> str:
     """"lqe_helpers.filter._covariance_sequence" for a frame of the pack's code."""
     module = frame.f_globals.get("__name__", "lqe_helpers")
@@ -372,7 +385,8 @@ def call(function: Callable, *args: object, name: str | None = None, where: str 
             f"inputs, in the notebook. {UNTRACEABLE}")
     if watch.tripped:
         raise failure(
-            f"{name} runs the pack's own {watch.tripped}{on}: the task is to write this step "
+            f"{name} runs the pack's own {shown_function(watch.tripped)}{on}: the task is to "
+            f"write this step "
             f"yourself, from the equation, with NumPy (@, np.linalg), not to call the pack's "
             f"solution")
     if kind == "timeout":

@@ -169,7 +169,8 @@ def test_no_function_of_the_pack_passes_as_a_function_tasks_answer(task) -> None
             try:
                 machinery.call_student(student, *args, name="answer", where="", allow=allowed)
             except CheckFailed as failure:
-                assert f"runs the pack's own {name}" in str(failure), (name, str(failure))
+                assert f"runs the pack's own {calling.shown_function(name)}" in str(failure), \
+                    (name, str(failure))
             else:
                 machinery_only.append(name)
     assert set(machinery_only) == {name for name, function in FUNCTIONS
@@ -274,3 +275,22 @@ def test_every_function_of_the_pack_a_task_cell_runs_is_refused_by_each_task_for
         runner.close()
     for check, names in refused.items():
         assert names, check
+
+
+def test_a_new_object_of_the_pack_is_named_by_its_class() -> None:
+    """The fifth trial: making a Scenario with dataclasses.replace inside a function task
+    was refused naming Scenario.__post_init__, an inner method the student never wrote."""
+    import dataclasses
+
+    from lqe_helpers.scenario import DEFAULT
+
+    def my_transition_matrix(dt):
+        dataclasses.replace(DEFAULT, sigma_v=2.0)
+        return np.eye(3)
+
+    with pytest.raises(CheckFailed) as failure:
+        machinery.call_student(my_transition_matrix, 0.01, name="my_transition_matrix",
+                               where="", allow=())
+    assert "runs the pack's own lqe_helpers.scenario.Scenario (making a new one)" in str(
+        failure.value)
+    assert "__post_init__" not in str(failure.value)
