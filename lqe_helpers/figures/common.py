@@ -177,7 +177,7 @@ def legend_above(ax: Axes, title: str = "") -> None:
     ax.set_title(title, pad=22)
 
 
-def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
+def trial_column(signals: Axes, errors: Axes | None, times: np.ndarray,
                  lines: Mapping[str, TrialLine],
                  values: Mapping[str, np.ndarray] | None = None, *,
                  error_linewidth: float, zero_line_first: bool) -> dict[str, Line2D]:
@@ -192,7 +192,8 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
     Parameters
     ----------
     signals, errors : matplotlib.axes.Axes
-        The top (position, cm) and bottom (estimate − true position, cm) panels.
+        The top (position, cm) and bottom (estimate − true position, cm) panels;
+        ``errors`` None for a trial's signals alone (every line on panel 0).
     times : array_like, shape (n,)
         Sample times (s).
     lines : mapping of str to (panel, role, label)
@@ -211,10 +212,18 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
     -------
     dict of str to Line2D
         The drawn lines by gid.
+
+    Raises
+    ------
+    ValueError
+        If ``errors`` is None and a line is on panel 1.
     """
     times = np.asarray(times, dtype=float)
     panels = (signals, errors)
-    if zero_line_first:
+    if errors is None and any(panel != 0 for panel, _, _ in lines.values()):
+        raise ValueError(f"lines must all be on panel 0 when errors is None, got "
+                         f"{[gid for gid, (panel, _, _) in lines.items() if panel != 0]}")
+    if zero_line_first and errors is not None:
         errors.axhline(0.0, **style("truth", linewidth=0.8))
     drawn = {}
     for gid, (panel, role, label) in lines.items():
@@ -222,7 +231,7 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
         y = np.zeros_like(times) if values is None else np.asarray(values[gid], dtype=float)
         (drawn[gid],) = panels[panel].plot(times, y, **style(role, gid=gid, label=label,
                                                              **extra))
-    if not zero_line_first:
+    if not zero_line_first and errors is not None:
         errors.axhline(0.0, **style("truth", linewidth=0.8))
     return drawn
 
