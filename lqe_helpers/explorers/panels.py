@@ -4,9 +4,9 @@ Building a figure's axes, ticks and legends costs more than most filter runs, so
 drawing function builds its panels once per figure with :func:`reuse_panels` and on
 later calls only replaces the data of the same artists; :func:`pin_axis_labels`
 saves the label placement of panels whose ticks never change. Axis limits that change
-in steps (:func:`set_ylim_in_steps`) and bands above the grid (:data:`DATA_UNDER_LINES`, of
-:mod:`lqe_helpers.plotting`, where the painters in :mod:`lqe_helpers.figures` read it) keep
-the repaint of a move small (:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
+in steps (:func:`set_ylim_in_steps`) and bands above the grid
+(:data:`lqe_helpers.plotting.DATA_UNDER_LINES`, which the painters in
+:mod:`lqe_helpers.figures` give them) keep the repaint of a move small (:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
 """
 
 from __future__ import annotations
@@ -21,7 +21,6 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from .. import validation
-from ..plotting import DATA_UNDER_LINES  # noqa: F401  (the explorers' name for it)
 
 #: Whatever a panel builder returns: artists, possibly in tuples, lists or dicts.
 Panels = TypeVar("Panels")

@@ -8,13 +8,15 @@ Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
 :func:`mean_band`), values marked by a labelled vertical line (:func:`mark_values`), a
 legend above a full panel (:func:`legend_above`), plain tick labels on a log axis
-(:func:`plain_log_ticks`) and the first seconds of a trial (:func:`first_seconds`).
+(:func:`plain_log_ticks`), the first seconds of a trial (:func:`first_seconds`) and the
+explorers' trial of 03 and 04 beside a side panel (:func:`trial_panels`).
 Nothing runs on import.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -234,6 +236,51 @@ def trial_column(signals: Axes, errors: Axes | None, times: np.ndarray,
     if not zero_line_first and errors is not None:
         errors.axhline(0.0, **style("truth", linewidth=0.8))
     return drawn
+
+
+class TrialPanels(NamedTuple):
+    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
+
+    signals: Axes
+    errors: Axes
+    side: Axes
+    lines: dict[str, Line2D]
+
+
+def trial_panels(figure: Figure, duration: float, times: np.ndarray,
+                 lines: Mapping[str, TrialLine], *, width_ratios: tuple[float, float],
+                 height_ratios: tuple[float, float], top: float, wspace: float,
+                 signal_limit: float, error_limit: float) -> TrialPanels:
+    """One trial over ``times`` (s) beside a side panel, on an empty figure (03, 04 explorers).
+
+    The left column holds the signals (position, ±``signal_limit`` cm) above the
+    errors (estimate − true position, ±``error_limit`` cm, with a zero line) over 0 to
+    ``duration`` s; each entry of ``lines`` becomes a line of zeros, its key as gid,
+    waiting for data, drawn by :func:`trial_column`. The caller adds the legend and
+    fills the side panel.
+    """
+    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
+                               left=0.07, right=0.98, bottom=0.1, top=top,
+                               hspace=0.1, wspace=wspace)
+    signals = figure.add_subplot(grid[0, 0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals)
+    side = figure.add_subplot(grid[:, 1])
+    drawn = trial_column(signals, errors, times, lines, error_linewidth=1.0,
+                         zero_line_first=False)
+    signals.set_ylim(-signal_limit, signal_limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.set_ylim(-error_limit, error_limit)
+    errors.set_xlim(0.0, duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels((signals, errors))
+    return TrialPanels(signals, errors, side, drawn)
+
+
+def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
+    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
+    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
 
 
 def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
