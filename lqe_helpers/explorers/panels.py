@@ -6,7 +6,8 @@ later calls only replaces the data of the same artists; :func:`pin_axis_labels`
 saves the label placement of panels whose ticks never change. Axis limits that change
 in steps (:func:`set_ylim_in_steps`) and bands above the grid
 (:data:`lqe_helpers.plotting.DATA_UNDER_LINES`, which the painters in
-:mod:`lqe_helpers.figures` give them) keep the repaint of a move small (:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
+:mod:`lqe_helpers.figures` give them) keep the repaint of a move small
+(:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
 """
 
 from __future__ import annotations
