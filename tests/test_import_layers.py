@@ -44,7 +44,7 @@ def layer_of(module: str) -> str:
     top = parts[0] if parts else ""
     if top in ("plotting", "figures"):
         return "drawing"
-    if top in ("experiments", "bias_model", "jerk_tuning"):
+    if top in ("experiments", "delayed", "own_runs", "bias_model", "jerk_tuning"):
         return "experiments"
     if top in ("explorers", "checks", "authoring"):
         return top

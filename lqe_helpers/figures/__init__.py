@@ -27,7 +27,7 @@ from .bias import (
 )
 from .common import paired_mse_figure, tracking_comparison_figure
 from .delay import delay_figure, delay_sweep_figure, prediction_error_sources_figure
-from .fusion import frequency_response_figure, fusion_trial_figure
+from .fusion import frequency_response_figure
 from .initial_covariance import (
     belief_and_error_figure,
     gains_figure,
@@ -49,7 +49,6 @@ __all__ = [
     "drift_figure",
     "estimate_error_figure",
     "frequency_response_figure",
-    "fusion_trial_figure",
     "gains_figure",
     "jerk_choice_figure",
     "jerk_sweep_figure",

@@ -2,7 +2,7 @@
 
 The figures: :func:`tracking_comparison_figure` (estimates beside the truth, their errors
 below; notebooks 01, 03, 04, 05; its painter :func:`trial_column` draws the explorers'
-trials of 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
+trials of 01, 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
 Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 (:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
@@ -185,11 +185,12 @@ def trial_column(signals: Axes, errors: Axes | None, times: np.ndarray,
                  error_linewidth: float, zero_line_first: bool) -> dict[str, Line2D]:
     """Draw one trial's signals over its errors: the one painter of that picture.
 
-    Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 and
-    :meth:`lqe_helpers.experiments.Tracking.figure`) and by the explorers of 03, 04 and 05
-    (:func:`lqe_helpers.explorers.common.build_trial_panels`,
-    :func:`lqe_helpers.explorers.delay.draw_delay`), which draw with no data and then
-    refill these lines on every slider move.
+    Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 through
+    :meth:`lqe_helpers.experiments.Tracking.figure` and
+    :meth:`lqe_helpers.delayed.DelayedTracking.comparison_figure`) and by the painters of
+    the explorers of 01, 03, 04 and 05 (:func:`lqe_helpers.figures.vision.vision_panel`,
+    signals only; :func:`trial_panels`; :func:`lqe_helpers.figures.delay.delay_panels`),
+    which draw with no data; the explorers refill these lines on every slider move.
 
     Parameters
     ----------
