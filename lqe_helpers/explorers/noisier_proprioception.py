@@ -26,7 +26,11 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from .. import experiments, validation
-from ..figures.noisier_proprioception import NoisierPanels, noisier_panels
+from ..figures.noisier_proprioception import (  # noqa: F401  (THEORY_TITLE: found here too)
+    THEORY_TITLE,
+    NoisierPanels,
+    noisier_panels,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
