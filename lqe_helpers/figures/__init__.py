@@ -7,6 +7,9 @@ importable from here (``figures.delay_figure(...)``) and lives in the module of 
 notebook, mirroring :mod:`lqe_helpers.explorers`: ``background`` (00), ``vision`` (01),
 ``initial_covariance`` (02), ``fusion`` (03), ``noisier_proprioception`` (04),
 ``delay`` (05), ``bias`` (06); ``common`` holds the figures and pieces several share.
+Each module also holds the painter of its notebook's explorer (``vision_panel``,
+``fusion_panels``, …, taking the Figure to draw on): it builds the explorer's artists once,
+with no data, and :mod:`lqe_helpers.explorers` refills them on every slider move.
 Nothing runs on import.
 """
 
