@@ -6,9 +6,7 @@ builder of the model a filter assumes (A, C, Q, R, z0, P0), :func:`track` simula
 the sensors and runs that filter, :func:`delay_and_compensate` delays its output.
 Their results draw their own standard figures (:meth:`Tracking.figure`,
 :meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only
-when a figure is asked for). :class:`DelayedTracking` lives in :mod:`lqe_helpers.delayed`
-and is importable from here; :mod:`lqe_helpers.own_runs` wraps a student's own arrays in
-these results.
+when a figure is asked for). :mod:`lqe_helpers.own_runs` wraps a student's own arrays in them.
 
 Each public function checks its inputs once, at its entry; what it calls inside
 (:mod:`lqe_helpers._matrices`) checks nothing again.
@@ -23,7 +21,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from . import _engine, _matrices, metrics, model, simulation, validation
-from .delayed import DelayedTracking, one_run
 from .filter import FilterResult, kalman_filter
 from .prediction import predict_ahead
 from .scenario import Scenario
@@ -212,14 +209,14 @@ class Tracking:
             raise ValueError(
                 f"against must map labels to at most {len(COMPARISON_ROLES)} Trackings of "
                 f"this scenario, got {[type(other).__name__ for other in against.values()]}")
-        estimates = {name: (one_run(other.positions, run), role)
+        estimates = {name: (validation.one_run(other.positions, run), role)
                      for (name, other), role in zip(against.items(),
                                                      COMPARISON_ROLES[:len(against)],
                                                      strict=True)}
-        estimates[label] = (one_run(self.positions, run), "estimate")
+        estimates[label] = (validation.one_run(self.positions, run), "estimate")
         shown = None
         if readings:
-            measured = one_run(self.measurements, run, trailing=2)
+            measured = validation.one_run(self.measurements, run, trailing=2)
             names = dict(reading_labels or {})
             shown = {names.get(sensor, f"{sensor} readings"): (measured[:, column], sensor)
                      for column, sensor in enumerate(self.sensors)}
@@ -392,6 +389,86 @@ def track(scenario: Scenario, sensors: Sequence[str] = ("vision",),
     result = _engine.filter_run(y, filter_.A, filter_.C, filter_.Q, filter_.R, filter_.z0,
                                 filter_.P0)
     return Tracking(scenario, sensors, y, result, filter_)
+
+
+@dataclass(frozen=True)
+class DelayedTracking:
+    """Question (e): the filter fed a signal that arrives ``steps`` samples late.
+
+    All arrays are on the wall-clock time axis: sample j is what the observer has at
+    time j·Δt. The first δ samples are NaN: nothing has arrived yet.
+
+    Attributes
+    ----------
+    tracking : Tracking
+        The filter run on the measurement stream (indexed by when it was sensed).
+    steps : int
+        The delay δ in samples.
+    delayed_measurements : ndarray, shape (..., n, m)
+        ``y_{j−δ}``, the reading available at time j.
+    delayed_estimates : ndarray, shape (..., n, 3)
+        ``ẑ_{j−δ}``, the newest estimate at time j, uncompensated (Tutorial eq. (8)).
+    predictions : ndarray, shape (..., n, 3)
+        ``z*_j = A^δ ẑ_{j−δ}``, the compensated estimate (Tutorial eq. (7)).
+    A student's own run (:func:`lqe_helpers.own_runs.delayed`) holds positions only, (n, 1).
+    """
+
+    tracking: Tracking
+    steps: int
+    delayed_measurements: np.ndarray
+    delayed_estimates: np.ndarray
+    predictions: np.ndarray
+
+    @property
+    def delay(self) -> float:
+        """The delay d = δ Δt (s)."""
+        return self.steps * self.tracking.scenario.dt
+
+    def figure(self, fast_window: tuple[float, float] = (3.75, 4.35), *,
+               run: int | tuple[int, ...] | None = None) -> Figure:
+        """Question (e)'s standard figure: truth, late readings, late and compensated estimate.
+
+        Built by :func:`lqe_helpers.figures.delay_figure` (the whole trial, the start
+        with nothing arrived yet shaded, and ``fast_window`` (s) of fast flight), so a
+        notebook writes ``delayed.figure()`` instead of passing six arrays.
+
+        ``fast_window``: (start, end) of the bottom-right zoom (s); ``run``: which run of a
+        batch (an index into the leading axes), required when there are leading axes.
+        Raises ValueError if ``run`` does not pick one run, or the delay is 0.
+        """
+        from . import figures
+
+        scenario = self.tracking.scenario
+        return figures.delay_figure(
+            scenario.times, scenario.truth[:, 0],
+            validation.one_run(self.delayed_measurements, run, trailing=2)[:, 0],
+            validation.one_run(self.delayed_estimates, run, trailing=2)[:, 0],
+            validation.one_run(self.predictions, run, trailing=2)[:, 0], self.delay, fast_window)
+
+    def comparison_figure(self, title: str = "", *,
+                          run: int | tuple[int, ...] | None = None) -> Figure:
+        """The delayed and compensated estimates beside a perfect but late eye, errors below
+        (:func:`lqe_helpers.figures.late_eye_figure`); ``run`` as in :meth:`figure`."""
+        from . import figures
+
+        truth = self.tracking.scenario.truth[:, 0]
+        return figures.late_eye_figure(
+            self.tracking.scenario.times, truth,
+            validation.one_run(self.delayed_estimates, run, trailing=2)[:, 0],
+            validation.one_run(self.predictions, run, trailing=2)[:, 0],
+            simulation.delay_signal(truth, self.steps, axis=-1), title)
+
+    def mse(self, which: str) -> np.ndarray:
+        """Per-run position MSE (cm²) of ``"delayed"`` or ``"predicted"`` estimates.
+
+        Skips the scenario's burn-in or the delay, whichever is longer.
+        """
+        arrays = {"delayed": self.delayed_estimates, "predicted": self.predictions}
+        if not isinstance(which, str) or which not in arrays:
+            raise ValueError(f"which must be one of {tuple(arrays)}, got {which!r}")
+        scenario = self.tracking.scenario
+        skip = max(scenario.burn_in_steps, self.steps)
+        return metrics.mse(arrays[which][..., 0], scenario.truth[:, 0], skip)
 
 
 def delay_and_compensate(tracking: Tracking, delay: float) -> DelayedTracking:

@@ -4,7 +4,7 @@ The notebooks' one-trial tasks make readings and estimates with the student's ow
 ``my_filter`` and ``compensate``; the figures after them show exactly those arrays. These
 functions check them once and wrap them in the results the pack's engine makes
 (:class:`~lqe_helpers.experiments.Tracking`,
-:class:`~lqe_helpers.delayed.DelayedTracking`), which draw themselves: a notebook passes
+:class:`~lqe_helpers.experiments.DelayedTracking`), which draw themselves: a notebook passes
 one object, not six arrays. Nothing here estimates anything: the estimates are the
 student's; the gains and covariances a result carries are the engine's for the same
 readings and model (they do not depend on the readings), for a band or a gain only.
@@ -18,7 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from . import experiments, model, validation
-from .delayed import DelayedTracking
+from .experiments import DelayedTracking
 from .scenario import DEFAULT, Scenario
 
 

@@ -98,6 +98,9 @@ def test_delayed_draws_the_students_arrays_in_both_figures() -> None:
              r"perfect but late eye $p_{j-\delta}$": (
                  simulation.delay_signal(truth, steps, axis=-1), "reference")},
             title="t")),
+        (own.comparison_figure("t"), figures.late_eye_figure(
+            DEFAULT.times, truth, delayed, compensated,
+            simulation.delay_signal(truth, steps, axis=-1), "t")),
     ]
     try:
         for by_object, by_arrays in pairs:

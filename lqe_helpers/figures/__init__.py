@@ -29,7 +29,12 @@ from .bias import (
     noise_sweep_figure,
 )
 from .common import paired_mse_figure, tracking_comparison_figure
-from .delay import delay_figure, delay_sweep_figure, prediction_error_sources_figure
+from .delay import (
+    delay_figure,
+    delay_sweep_figure,
+    late_eye_figure,
+    prediction_error_sources_figure,
+)
 from .fusion import frequency_response_figure
 from .initial_covariance import (
     belief_and_error_figure,
@@ -56,6 +61,7 @@ __all__ = [
     "jerk_choice_figure",
     "jerk_sweep_figure",
     "lag_figure",
+    "late_eye_figure",
     "mse_intervals_figure",
     "noise_sweep_figure",
     "open_loop_figure",

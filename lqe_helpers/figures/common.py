@@ -187,7 +187,7 @@ def trial_column(signals: Axes, errors: Axes | None, times: np.ndarray,
 
     Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 through
     :meth:`lqe_helpers.experiments.Tracking.figure` and
-    :meth:`lqe_helpers.delayed.DelayedTracking.comparison_figure`) and by the painters of
+    :meth:`lqe_helpers.experiments.DelayedTracking.comparison_figure`) and by the painters of
     the explorers of 01, 03, 04 and 05 (:func:`lqe_helpers.figures.vision.vision_panel`,
     signals only; :func:`trial_panels`; :func:`lqe_helpers.figures.delay.delay_panels`),
     which draw with no data; the explorers refill these lines on every slider move.

@@ -18,7 +18,15 @@ from matplotlib.lines import Line2D
 from matplotlib.patches import Patch, Rectangle
 
 from ..plotting import COLORS, DATA_UNDER_LINES, style
-from .common import TrialLine, interval_arrays, label_axes, mean_band, plot_series, trial_column
+from .common import (
+    TrialLine,
+    interval_arrays,
+    label_axes,
+    mean_band,
+    plot_series,
+    tracking_comparison_figure,
+    trial_column,
+)
 
 
 def delay_figure(times: np.ndarray, truth: np.ndarray, delayed_readings: np.ndarray,
@@ -226,6 +234,32 @@ def prediction_error_sources_figure(theory_delays: np.ndarray, theory: np.ndarra
                xlim=(x[0], x[-1]), ylim=(1e-4 * theory.min(), 10.0 * theory.max()),
                legend={"loc": "upper left", "fontsize": 9})
     return fig
+
+
+def late_eye_figure(times: np.ndarray, truth: np.ndarray, delayed: np.ndarray,
+                    compensated: np.ndarray, late_eye: np.ndarray, title: str = "") -> Figure:
+    """Notebook 05's Figure 3: the delayed and compensated estimates and a perfect but late eye.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    truth, delayed, compensated, late_eye : array_like, shape (n,)
+        True position, the delayed estimate ``p̂_{j−δ}``, the compensated ``p*_j`` and the
+        true position seen δ samples late (cm); NaN where nothing has arrived.
+    title : str
+        Title of the top panel.
+
+    Returns
+    -------
+    Figure
+        :func:`~lqe_helpers.figures.common.tracking_comparison_figure` of the three: blue,
+        vermillion and pink dotted on top, their errors below.
+    """
+    return tracking_comparison_figure(times, truth, {
+        r"delayed estimate $\hat p_{j-\delta}$": (delayed, "estimate"),
+        r"compensated $p^*_j$": (compensated, "prediction"),
+        r"perfect but late eye $p_{j-\delta}$": (late_eye, "reference")}, title=title)
 
 
 #: The explorer's lines: gid → (axes index, role, legend label). The gids let tests find
