@@ -6,7 +6,7 @@ builder of the model a filter assumes (A, C, Q, R, z0, P0), :func:`track` simula
 the sensors and runs that filter, :func:`delay_and_compensate` delays its output.
 Their results draw their own standard figures (:meth:`Tracking.figure`,
 :meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only
-when a figure is asked for).
+when a figure is asked for). :mod:`lqe_helpers.own_runs` wraps a student's own arrays in them.
 
 Each public function checks its inputs once, at its entry; what it calls inside
 (:mod:`lqe_helpers._matrices`) checks nothing again.
@@ -165,7 +165,8 @@ class Tracking:
 
     def figure(self, label: str = "filtered estimate", *,
                against: Mapping[str, Tracking] | None = None, readings: bool = True,
-               title: str = "", run: int | tuple[int, ...] | None = None) -> Figure:
+               title: str = "", run: int | tuple[int, ...] | None = None,
+               reading_labels: Mapping[str, str] | None = None) -> Figure:
         """This run's estimate beside the truth, its error below: the standard figure.
 
         Built by :func:`lqe_helpers.figures.tracking_comparison_figure`, so a notebook
@@ -185,6 +186,9 @@ class Tracking:
         run : int or tuple of int, optional
             Which run of a batch (an index into the leading axes, the same in every
             tracking); required when there are leading axes.
+        reading_labels : mapping of str to str, optional
+            Legend label of a sensor's readings, by sensor (e.g. ``{"vision": "noisy
+            vision"}``); default "<sensor> readings".
 
         Returns
         -------
@@ -205,32 +209,19 @@ class Tracking:
             raise ValueError(
                 f"against must map labels to at most {len(COMPARISON_ROLES)} Trackings of "
                 f"this scenario, got {[type(other).__name__ for other in against.values()]}")
-        estimates = {name: (_one_run(other.positions, run), role)
+        estimates = {name: (validation.one_run(other.positions, run), role)
                      for (name, other), role in zip(against.items(),
                                                      COMPARISON_ROLES[:len(against)],
                                                      strict=True)}
-        estimates[label] = (_one_run(self.positions, run), "estimate")
+        estimates[label] = (validation.one_run(self.positions, run), "estimate")
         shown = None
         if readings:
-            measured = _one_run(self.measurements, run, trailing=2)
-            shown = {f"{sensor} readings": (measured[:, column], sensor)
+            measured = validation.one_run(self.measurements, run, trailing=2)
+            names = dict(reading_labels or {})
+            shown = {names.get(sensor, f"{sensor} readings"): (measured[:, column], sensor)
                      for column, sensor in enumerate(self.sensors)}
         return figures.tracking_comparison_figure(self.scenario.times, self.scenario.truth[:, 0],
                                                   estimates, readings=shown, title=title)
-
-
-def _one_run(values: np.ndarray, run: int | tuple[int, ...] | None,
-             trailing: int = 1) -> np.ndarray:
-    """``values[run]``, which must leave ``trailing`` axes (one run of a batch)."""
-    index = () if run is None else np.index_exp[run]
-    try:
-        one = values[index]
-    except (IndexError, TypeError):
-        one = None
-    if one is None or one.ndim != trailing:
-        raise ValueError(
-            f"run must pick one run of the leading axes {values.shape[:-trailing]}, got {run!r}")
-    return one
 
 
 def _sensor_sigmas(name: str, sigmas: object, sensors: tuple[str, ...]) -> np.ndarray:
@@ -419,6 +410,7 @@ class DelayedTracking:
         ``ẑ_{j−δ}``, the newest estimate at time j, uncompensated (Tutorial eq. (8)).
     predictions : ndarray, shape (..., n, 3)
         ``z*_j = A^δ ẑ_{j−δ}``, the compensated estimate (Tutorial eq. (7)).
+    A student's own run (:func:`lqe_helpers.own_runs.delayed`) holds positions only, (n, 1).
     """
 
     tracking: Tracking
@@ -440,27 +432,31 @@ class DelayedTracking:
         with nothing arrived yet shaded, and ``fast_window`` (s) of fast flight), so a
         notebook writes ``delayed.figure()`` instead of passing six arrays.
 
-        Parameters
-        ----------
-        fast_window : tuple of float
-            (start, end) of the bottom-right zoom (s).
-        run : int or tuple of int, optional
-            Which run of a batch (an index into the leading axes); required when there
-            are leading axes.
-
-        Raises
-        ------
-        ValueError
-            If ``run`` does not pick one run, or the delay is 0 (nothing to show).
+        ``fast_window``: (start, end) of the bottom-right zoom (s); ``run``: which run of a
+        batch (an index into the leading axes), required when there are leading axes.
+        Raises ValueError if ``run`` does not pick one run, or the delay is 0.
         """
         from . import figures
 
         scenario = self.tracking.scenario
         return figures.delay_figure(
             scenario.times, scenario.truth[:, 0],
-            _one_run(self.delayed_measurements, run, trailing=2)[:, 0],
-            _one_run(self.delayed_estimates, run, trailing=2)[:, 0],
-            _one_run(self.predictions, run, trailing=2)[:, 0], self.delay, fast_window)
+            validation.one_run(self.delayed_measurements, run, trailing=2)[:, 0],
+            validation.one_run(self.delayed_estimates, run, trailing=2)[:, 0],
+            validation.one_run(self.predictions, run, trailing=2)[:, 0], self.delay, fast_window)
+
+    def comparison_figure(self, title: str = "", *,
+                          run: int | tuple[int, ...] | None = None) -> Figure:
+        """The delayed and compensated estimates beside a perfect but late eye, errors below
+        (:func:`lqe_helpers.figures.late_eye_figure`); ``run`` as in :meth:`figure`."""
+        from . import figures
+
+        truth = self.tracking.scenario.truth[:, 0]
+        return figures.late_eye_figure(
+            self.tracking.scenario.times, truth,
+            validation.one_run(self.delayed_estimates, run, trailing=2)[:, 0],
+            validation.one_run(self.predictions, run, trailing=2)[:, 0],
+            simulation.delay_signal(truth, self.steps, axis=-1), title)
 
     def mse(self, which: str) -> np.ndarray:
         """Per-run position MSE (cm²) of ``"delayed"`` or ``"predicted"`` estimates.

@@ -39,6 +39,12 @@ STYLES = {
     "reference": {"color": COLORS["reference"], "linestyle": ":", "linewidth": 1.4},
 }
 
+#: zorder of bands, bars and spans that an explorer's slider changes: above the grid and
+#: ticks (1.5, matplotlib's ``axes.axisbelow: line``) and below lines (2). At the default
+#: zorder 1 they would lie under the grid, and every move would repaint each axis with
+#: its tick labels (see :class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
+DATA_UNDER_LINES = 1.6
+
 #: rcParams applied by :func:`use_pack_style`.
 RC_PARAMS = {
     "figure.figsize": (9.0, 4.0),

@@ -382,6 +382,21 @@ def covariance(name: str, value: object, size: int | None = None,
     return array
 
 
+def one_run(values: np.ndarray, run: int | tuple[int, ...] | None,
+            trailing: int = 1) -> np.ndarray:
+    """``values[run]``, which must leave ``trailing`` axes: one run of a batch (a result's
+    figure draws one run). Raises ValueError naming ``run`` if it does not pick one."""
+    index = () if run is None else np.index_exp[run]
+    try:
+        one = values[index]
+    except (IndexError, TypeError):
+        one = None
+    if one is None or one.ndim != trailing:
+        raise ValueError(
+            f"run must pick one run of the leading axes {values.shape[:-trailing]}, got {run!r}")
+    return one
+
+
 def broadcast_batches(**shapes: tuple[int, ...]) -> tuple[int, ...]:
     """Broadcast named batch shapes, raising ``ValueError`` that lists them if they clash."""
     try:

@@ -1,37 +1,121 @@
-"""One drawing function per picture: the notebooks' and the explorers' trial (03, 04, 05).
+"""One drawing function per picture: explorers are drawn by painters in figures/ (issue 25).
 
-A trial's signals over its errors are drawn by :func:`lqe_helpers.figures.common.trial_column`
-only: the notebooks' figure (``tracking_comparison_figure``, ``fusion_trial_figure``,
-``Tracking.figure``) calls it with data, the explorers of 03, 04 and 05 call it once with
-no data and then refill its lines.
+Each explorer's picture is built by the painters its row of docs/architecture.md's pictures
+table names (``draw_fusion``: ``fusion_panels``, ``trial_panels``, ``trial_column``), and
+by no other; ``explorers/`` holds no matplotlib drawing call outside its framework, so a
+second painter written there fails here. A trial's signals over its errors is drawn by
+:func:`lqe_helpers.figures.common.trial_column` only, for the notebooks' figure and for the
+explorers of 01, 03, 04 and 05.
 """
 
 from __future__ import annotations
 
+import ast
+import importlib
+import inspect
+import pkgutil
+import re
+from pathlib import Path
+
 import matplotlib.pyplot as plt
 import pytest
 
+import lqe_helpers.figures as figures_package
 from lqe_helpers import experiments
-from lqe_helpers.explorers import delay, fusion, noisier_proprioception
-from lqe_helpers.figures import common
 from lqe_helpers.scenario import DEFAULT
+
+ROOT = Path(__file__).resolve().parent.parent
+EXPLORERS = ROOT / "lqe_helpers" / "explorers"
+#: The explorers' framework: it builds no picture (it caches, repaints and encodes one).
+FRAMEWORK = {"__init__", "base", "cache", "layers", "panels", "png", "sliders",
+             "student_functions"}
+#: Matplotlib calls that draw or lay out a picture: a painter's job, in figures/.
+DRAWING_CALLS = {"plot", "fill_between", "bar", "barh", "scatter", "errorbar", "imshow",
+                 "axhline", "axvline", "axvspan", "axhspan", "annotate", "text", "legend",
+                 "set_title", "set_xlabel", "set_ylabel", "set_xscale", "set_yscale",
+                 "set_xticks", "set_yticks", "add_subplot", "subplots", "add_gridspec",
+                 "subplots_adjust", "align_ylabels", "suptitle"}
+FACTORIES = {
+    "draw_background": ("background", "explore_background"),
+    "draw_vision": ("vision", "explore_vision"),
+    "draw_initial_covariance": ("initial_covariance", "explore_initial_covariance"),
+    "draw_fusion": ("fusion", "explore_fusion"),
+    "draw_noisier_proprioception": ("noisier_proprioception",
+                                    "explore_noisier_proprioception"),
+    "draw_delay": ("delay", "explore_delay"),
+    "draw_bias": ("bias", "explore_bias"),
+}
+
+
+def painters_in_table() -> dict[str, set[str]]:
+    """By explorer draw function, the painters its row of the pictures table names."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    section = text[text.index("## Each picture and its one drawing function"):
+                   text.index("## Where to change what")]
+    rows = re.findall(r"^\| \d\d \|.*\| `(draw_\w+)`: ([^|]+) \|$", section, re.MULTILINE)
+    return {drawer: set(re.findall(r"`(\w+)`", painters)) for drawer, painters in rows}
+
+
+def figure_functions() -> dict[str, tuple[object, str]]:
+    """Every painter of figures/ (a public function whose first parameter is the Figure or
+    Axes it draws on), by name: (module, name)."""
+    found = {}
+    for info in pkgutil.iter_modules(figures_package.__path__):
+        module = importlib.import_module(f"lqe_helpers.figures.{info.name}")
+        for name, value in vars(module).items():
+            if (inspect.isfunction(value) and not name.startswith("_")
+                    and value.__module__ == module.__name__ and _draws_on(value)):
+                found[name] = (module, name)
+    return found
+
+
+def _draws_on(function: object) -> bool:
+    """True if ``function``'s first parameter is a matplotlib Figure or Axes."""
+    parameters = list(inspect.signature(function).parameters.values())
+    return bool(parameters) and str(parameters[0].annotation) in {"Figure", "Axes"}
 
 
 @pytest.fixture
-def painted(monkeypatch) -> list[dict]:
-    """The ``lines`` of every call of ``trial_column``, wherever it is called from."""
-    calls: list[dict] = []
-    original = common.trial_column
+def painted(monkeypatch) -> list[tuple[str, dict | None]]:
+    """(name, lines or None) of every call of a figures/ function, wherever called from."""
+    import sys
 
-    def recording(signals, errors, times, lines, *args, **kwargs):
-        calls.append(dict(lines))
-        return original(signals, errors, times, lines, *args, **kwargs)
+    calls: list[tuple[str, dict | None]] = []
+    for name, (module, attribute) in figure_functions().items():
+        original = getattr(module, attribute)
 
-    monkeypatch.setattr(common, "trial_column", recording)
-    import lqe_helpers.explorers.common as explorer_common
-    monkeypatch.setattr(explorer_common, "trial_column", recording)
-    monkeypatch.setattr(delay, "trial_column", recording)
+        def recording(*args, __name=name, __original=original, **kwargs):
+            lines = args[3] if __name == "trial_column" else None
+            calls.append((__name, dict(lines) if lines is not None else None))
+            return __original(*args, **kwargs)
+
+        # Everywhere the function is bound by name: its module and every importer.
+        for loaded in list(sys.modules.values()):
+            if (getattr(loaded, "__name__", "").startswith("lqe_helpers")
+                    and getattr(loaded, name, None) is original):
+                monkeypatch.setattr(loaded, name, recording)
     return calls
+
+
+def test_the_table_names_a_painter_for_every_explorer() -> None:
+    table = painters_in_table()
+    assert set(table) == set(FACTORIES)
+    known = figure_functions()
+    for drawer, painters in table.items():
+        assert painters, f"{drawer}: no painter named"
+        assert painters <= set(known), f"{drawer}: not a function of figures/: {painters}"
+
+
+@pytest.mark.parametrize("drawer", sorted(FACTORIES))
+def test_each_explorer_is_drawn_by_the_painters_its_row_names(painted, drawer) -> None:
+    module, factory = FACTORIES[drawer]
+    explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
+    assert {name for name, _ in painted} == painters_in_table()[drawer]
+    # A slider move refills the artists: no painter runs again.
+    before = len(painted)
+    name, slider = next(iter(explorer.sliders.items()))
+    slider.value = slider.max if not hasattr(slider, "base") else slider.base ** slider.max
+    assert explorer.problem == "" and len(painted) == before, name
 
 
 def test_the_notebooks_trial_figure_is_painted_by_trial_column(painted) -> None:
@@ -39,18 +123,42 @@ def test_the_notebooks_trial_figure_is_painted_by_trial_column(painted) -> None:
     fused = experiments.track(DEFAULT, ("vision", "proprioception"))
     fig = fused.figure("fused", against={"vision only": vision})
     plt.close(fig)
-    assert len(painted) == 1
-    lines = painted[0]
-    assert lines["truth"] == (0, "truth", "true position")
-    assert lines["estimate: fused"] == (0, "estimate", "fused")
-    assert lines["error: vision only"] == (1, "alternative", "vision only")
+    trials = [lines for name, lines in painted if name == "trial_column"]
+    assert len(trials) == 1
+    assert trials[0]["truth"] == (0, "truth", "true position")
+    assert trials[0]["estimate: fused"] == (0, "estimate", "fused")
+    assert trials[0]["error: vision only"] == (1, "alternative", "vision only")
 
 
-@pytest.mark.parametrize("factory", [fusion.explore_fusion,
-                                     noisier_proprioception.explore_noisier_proprioception,
-                                     delay.explore_delay])
-def test_the_explorers_trial_is_painted_by_the_same_function(painted, factory) -> None:
-    explorer = factory()
-    assert len(painted) == 1
+@pytest.mark.parametrize("drawer", ["draw_vision", "draw_fusion", "draw_noisier_proprioception",
+                                    "draw_delay"])
+def test_the_explorers_trial_is_painted_by_the_same_function(painted, drawer) -> None:
+    module, factory = FACTORIES[drawer]
+    explorer = getattr(importlib.import_module(f"lqe_helpers.explorers.{module}"), factory)()
+    trials = [lines for name, lines in painted if name == "trial_column"]
+    assert len(trials) == 1
     drawn = {line.get_gid() for ax in explorer.figure.axes for line in ax.get_lines()}
-    assert set(painted[0]) <= drawn
+    assert set(trials[0]) <= drawn
+
+
+def drawing_calls(path: Path) -> list[str]:
+    """``name:line`` of every matplotlib drawing call (``x.plot(...)``, …) in ``path``."""
+    tree = ast.parse(path.read_text(encoding="utf-8"))
+    return [f"{node.func.attr}:{node.lineno}" for node in ast.walk(tree)
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)
+            and node.func.attr in DRAWING_CALLS]
+
+
+def test_explorers_hold_no_drawing_code_of_their_own() -> None:
+    found = {path.stem: calls for path in sorted(EXPLORERS.glob("*.py"))
+             if path.stem not in FRAMEWORK and (calls := drawing_calls(path))}
+    assert found == {}, "draw these in a painter in figures/, the explorer refills it"
+
+
+def test_a_second_painter_in_an_explorer_would_fail(tmp_path) -> None:
+    source = (EXPLORERS / "vision.py").read_text(encoding="utf-8")
+    second = tmp_path / "vision.py"
+    second.write_text(source + "\n\ndef _again(ax):\n    ax.fill_between([0], [0], [1])\n",
+                      encoding="utf-8")
+    assert drawing_calls(EXPLORERS / "vision.py") == []
+    assert [call.split(":")[0] for call in drawing_calls(second)] == ["fill_between"]

@@ -18,16 +18,23 @@ from __future__ import annotations
 
 import dataclasses
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import FixedLocator, FuncFormatter, MultipleLocator, NullLocator
 
 from .. import experiments, validation
-from ..plotting import COLORS, label_time_position, style
+from ..figures.background import (  # noqa: F401  (the labels: tests and readers find them here)
+    AMPLITUDE_LABEL,
+    ESTIMATE_LABEL,
+    GROWTH_LABEL,
+    GROWTH_TITLE,
+    REFERENCE_LABEL,
+    TRACKING_TITLE,
+    TRUTH_LABEL,
+    VISION_LABEL,
+    BackgroundPanels,
+    background_panels,
+)
 from ..prediction import OpenLoop, amplitude_crossing, open_loop
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
@@ -48,22 +55,6 @@ START_JERK_STD = 1000.0
 
 #: How the numbers line starts: whose filter runs (the student writes theirs in notebook 01).
 WHOSE_FILTER = "The pack's vision-only filter (yours comes in notebook 01),"
-
-#: Titles of the two panels; they never change (the numbers go beside the figure).
-GROWTH_TITLE = "Uncertainty once the measurements stop"
-TRACKING_TITLE = "Tracking"
-#: Gap (points) between a panel and its title: wide enough that the title is not
-#: painted again with the top spine, which every move repaints over the curves.
-TITLE_PAD = 10.0
-
-#: Labels of the plotted artists, so tests and readers can find them.
-GROWTH_LABEL = "2σ at this σ_j"
-REFERENCE_LABEL = "2σ at the scenario's σ_j"
-AMPLITUDE_LABEL = "flight amplitude"
-VISION_LABEL = "vision"
-TRUTH_LABEL = "true path"
-ESTIMATE_LABEL = "filtered estimate"
-
 
 def steady_estimate_covariance(scenario: Scenario) -> np.ndarray:
     """Covariance (3, 3) of the vision-only filter's estimate once it has settled.
@@ -87,55 +78,13 @@ def _crossing_text(loop: OpenLoop, amplitude: float) -> str:
     return f"after {crossing:.2f} s"
 
 
-class _Panels(NamedTuple):
-    """The artists :func:`draw_background` builds on a figure and fills on every call."""
-
-    axes: tuple[Axes, Axes]
-    growth: Line2D
-    vision: Line2D
-    estimate: Line2D
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build both panels on the empty ``figure``: fixed artists drawn, the rest empty."""
-    growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
+def _build(figure: Figure, scenario: Scenario) -> BackgroundPanels:
+    """The explorer's panels on the empty ``figure``, by notebook 00's painter of them."""
     reference = open_loop(scenario, np.zeros(3), steady_estimate_covariance(scenario),
                           OPEN_LOOP_DURATION)
-    growth_ax.plot(reference.times, 2 * reference.position_stds,
-                   **style("reference", label=REFERENCE_LABEL))
-    growth, = growth_ax.plot(reference.times, np.ones_like(reference.times),
-                             **style("prediction", label=GROWTH_LABEL))
-    growth_ax.axhline(scenario.amplitude, color=COLORS["truth"], linewidth=0.8,
-                      label=AMPLITUDE_LABEL)
-    growth_ax.set_yscale("log")
-    growth_ax.set_ylim(1e-2, 1e3)
-    # Decades only, as plain numbers: minor ticks and mathtext labels would double
-    # the time a slider move takes to render.
-    growth_ax.yaxis.set_major_locator(FixedLocator(np.logspace(-2, 3, 6)))
-    growth_ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-    growth_ax.yaxis.set_minor_locator(NullLocator())
-    growth_ax.set_xlim(0, OPEN_LOOP_DURATION)
-    growth_ax.set_xlabel("time since the last measurement (s)")
-    growth_ax.set_ylabel("2σ of predicted position (cm)")
-    growth_ax.set_title(GROWTH_TITLE, fontsize=10, pad=TITLE_PAD)
-    # Legends below the panels, never over a moving curve: a legend a curve passes
-    # under has to be painted again on every slider move.
-    growth_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=2)
-
-    times = scenario.times
-    window = (times >= TRACKING_WINDOW[0]) & (times <= TRACKING_WINDOW[1])
-    empty = np.zeros(int(window.sum()))
-    vision, = track_ax.plot(times[window], empty, **style("vision", label=VISION_LABEL))
-    track_ax.plot(times[window], scenario.truth[window, 0], **style("truth", label=TRUTH_LABEL))
-    estimate, = track_ax.plot(times[window], empty, **style("estimate", label=ESTIMATE_LABEL))
-    track_ax.set_ylim(-1.7 * scenario.amplitude, 1.7 * scenario.amplitude)
-    track_ax.set_xlim(*TRACKING_WINDOW)
-    track_ax.xaxis.set_major_locator(MultipleLocator(1.0))  # fewer labels: faster redraws
-    label_time_position(track_ax)
-    track_ax.set_title(TRACKING_TITLE, fontsize=10, pad=TITLE_PAD)
-    track_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=3)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.25, wspace=0.22)
-    return _Panels((growth_ax, track_ax), growth, vision, estimate)
+    return background_panels(figure, reference.times, 2 * reference.position_stds,
+                             scenario.times, scenario.truth[:, 0], amplitude=scenario.amplitude,
+                             growth_duration=OPEN_LOOP_DURATION, window=TRACKING_WINDOW)
 
 
 def draw_background(figure: Figure, *, jerk_std: float, scenario: Scenario = DEFAULT,

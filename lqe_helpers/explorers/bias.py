@@ -25,21 +25,30 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import MultipleLocator
 
 from .. import bias_model, experiments
-from ..plotting import COLORS, label_time_position, style
+from ..figures.bias import (  # noqa: F401  (the labels and axes, found here too)
+    BIAS_AXIS,
+    BIAS_BAND_LABEL,
+    BIAS_ESTIMATE_LABEL,
+    BIAS_TICK,
+    BIAS_TITLE,
+    DEAD_RECKONING_LABEL,
+    ESTIMATE_LABEL,
+    PATH_TITLE,
+    TRUE_BIAS_LABEL,
+    TRUTH_LABEL,
+    VISION_LABEL,
+    BiasPanels,
+    bias_panels,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
-from .panels import DATA_UNDER_LINES, reuse_panels
+from .panels import reuse_panels
 from .sliders import float_slider, log_slider, starting_value
 
 #: Slider range of the true bias b (cm/s²): up to 60 % of the path's peak acceleration.
@@ -52,77 +61,14 @@ SIGMA_A_RANGE = (1.0, 1000.0)
 #: Slider range and step of σ_v (cm), covering the tutorial's 1.5 and 4.5 cm.
 SIGMA_V_RANGE = (0.5, 6.0)
 SIGMA_V_STEP = 0.5
-#: Fixed y range of the bias panel (cm/s²): every slider value fits, the axes stay put.
-BIAS_AXIS = (-80.0, 80.0)
-#: Spacing of the bias panel's y ticks (cm/s²).
-BIAS_TICK = 40.0
-
 #: Seconds shown (s): the bias settles and dead reckoning leaves the plot well before.
 WINDOW = 4.0
 
-#: Labels of the plotted artists, so tests and readers can find them.
-TRUE_BIAS_LABEL = "true bias"
-BIAS_ESTIMATE_LABEL = "estimated bias"
-BIAS_BAND_LABEL = "±2σ"
-TRUTH_LABEL = "true path"
-VISION_LABEL = "vision"
-ESTIMATE_LABEL = "filtered estimate"
-DEAD_RECKONING_LABEL = "dead reckoning"
-#: Titles of the two panels; they never change, so they stay in the cached background.
-BIAS_TITLE = "bias of the acceleration signal"
-PATH_TITLE = "position of the hand"
-
-
-class _Panels(NamedTuple):
-    """The artists :func:`draw_bias` builds on a figure and fills on every call."""
-
-    axes: tuple[Axes, Axes]
-    band: FillBetweenPolyCollection
-    true_bias: Line2D
-    bias_estimate: Line2D
-    vision: Line2D
-    estimate: Line2D
-    dead_reckoning: Line2D
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build both panels on the empty ``figure``: fixed artists drawn, the rest empty."""
-    bias_ax, path_ax = figure.subplots(1, 2)
-    times = scenario.times[_shown(scenario)]
-    empty = np.zeros_like(times)
-    band = bias_ax.fill_between(times, empty, empty, color=COLORS["estimate"], alpha=0.15,
-                                linewidth=0, label=BIAS_BAND_LABEL, zorder=DATA_UNDER_LINES)
-    true_bias, = bias_ax.plot(times, empty, **style("truth", label=TRUE_BIAS_LABEL))
-    bias_estimate, = bias_ax.plot(times, empty, **style("estimate", label=BIAS_ESTIMATE_LABEL))
-    bias_ax.set_ylim(*BIAS_AXIS)
-    bias_ax.set_xlim(0, WINDOW)
-    # Fewer tick labels than matplotlib's default: text is most of a redraw's cost.
-    bias_ax.yaxis.set_major_locator(MultipleLocator(BIAS_TICK))
-    bias_ax.set_xlabel("time (s)")
-    bias_ax.set_ylabel("bias (cm/s²)")
-    bias_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=3)
-    # Lifted clear of the axes area, which the band (clipped to it) repaints on every
-    # move: at the default pad the title would be repainted with it.
-    bias_ax.set_title(BIAS_TITLE, fontsize=10, pad=10)
-
-    vision, = path_ax.plot(times, empty, **style("vision", label=VISION_LABEL))
-    path_ax.plot(times, scenario.truth[_shown(scenario), 0], **style("truth", label=TRUTH_LABEL))
-    estimate, = path_ax.plot(times, empty, **style("estimate", label=ESTIMATE_LABEL))
-    dead_reckoning, = path_ax.plot(times, empty,
-                                   **style("alternative", label=DEAD_RECKONING_LABEL))
-    limit = 2.0 * scenario.amplitude
-    path_ax.set_ylim(-limit, limit)
-    path_ax.set_xlim(0, WINDOW)
-    path_ax.yaxis.set_major_locator(MultipleLocator(scenario.amplitude))
-    for ax in (bias_ax, path_ax):
-        ax.xaxis.set_major_locator(MultipleLocator(1.0))
-    label_time_position(path_ax)
-    path_ax.set_title(PATH_TITLE, fontsize=10, pad=10)
-    path_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=4,
-                   markerscale=2, columnspacing=1.0, handlelength=1.8)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.22, wspace=0.2)
-    return _Panels((bias_ax, path_ax), band, true_bias, bias_estimate, vision,
-                   estimate, dead_reckoning)
+def _build(figure: Figure, scenario: Scenario) -> BiasPanels:
+    """The explorer's panels on the empty ``figure``, by notebook 06's painter of them."""
+    shown = _shown(scenario)
+    return bias_panels(figure, scenario.times[shown], scenario.truth[shown, 0],
+                       amplitude=scenario.amplitude, window=WINDOW)
 
 
 def _shown(scenario: Scenario) -> np.ndarray:

@@ -1,76 +1,22 @@
-"""The one-trial layout shared by the fusion explorers of questions (c) and (d).
+"""What the fusion explorers of questions (c) and (d) share, besides their painter.
 
 Both :mod:`lqe_helpers.explorers.fusion` and
 :mod:`lqe_helpers.explorers.noisier_proprioception` show one trial of a vision-only
 and a fused filter in a left column (signals over errors) beside a side panel of
-their own, with a legend above. The trial's MSEs are not drawn in the figure: the
-drawing function returns them as text (:func:`trial_numbers`), which the explorer
-shows between its sliders and the picture. This module holds that common part; each
-explorer fills its side panel.
+their own, drawn by :func:`lqe_helpers.figures.common.trial_panels`. This module holds
+the data they refill it with (:func:`estimate_lines`, :func:`position_shares`) and the
+trial's MSEs as text (:func:`trial_numbers`), which the explorer shows between its
+sliders and the picture.
 """
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from typing import NamedTuple
-
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
 
 from .. import experiments
-from ..figures.common import TrialLine, trial_column
 from ..scenario import Scenario
 
-__all__ = ["TrialLine", "TrialPanels", "build_trial_panels", "estimate_lines",
-           "legend_handles", "position_shares", "significant", "trial_numbers"]
-
-
-class TrialPanels(NamedTuple):
-    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
-
-    signals: Axes
-    errors: Axes
-    side: Axes
-    lines: dict[str, Line2D]
-
-
-def build_trial_panels(figure: Figure, scenario: Scenario, lines: Mapping[str, TrialLine], *,
-                       width_ratios: tuple[float, float], height_ratios: tuple[float, float],
-                       top: float, wspace: float, signal_limit: float,
-                       error_limit: float) -> TrialPanels:
-    """Lay out one trial over ``scenario.times`` beside a side panel, on an empty figure.
-
-    The left column holds the signals (position, ±``signal_limit`` cm) above the
-    errors (estimate − true position, ±``error_limit`` cm, with a zero line); each
-    entry of ``lines`` becomes a line of zeros, its key as gid, waiting for data,
-    drawn by the notebooks' painter of this picture
-    (:func:`lqe_helpers.figures.common.trial_column`). The caller adds the legend and
-    fills the side panel.
-    """
-    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
-                               left=0.07, right=0.98, bottom=0.1, top=top,
-                               hspace=0.1, wspace=wspace)
-    signals = figure.add_subplot(grid[0, 0])
-    errors = figure.add_subplot(grid[1, 0], sharex=signals)
-    side = figure.add_subplot(grid[:, 1])
-    drawn = trial_column(signals, errors, scenario.times, lines, error_linewidth=1.0,
-                         zero_line_first=False)
-    signals.set_ylim(-signal_limit, signal_limit)
-    signals.set_ylabel("position (cm)")
-    signals.tick_params(labelbottom=False)
-    errors.set_ylim(-error_limit, error_limit)
-    errors.set_xlim(0.0, scenario.duration)
-    errors.set_xlabel("time (s)")
-    errors.set_ylabel("error (cm)")
-    figure.align_ylabels((signals, errors))
-    return TrialPanels(signals, errors, side, drawn)
-
-
-def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
-    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
-    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
+__all__ = ["estimate_lines", "position_shares", "significant", "trial_numbers"]
 
 
 def estimate_lines(truth: np.ndarray, vision: experiments.Tracking,

@@ -22,21 +22,16 @@ import dataclasses
 import math
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.patches import Patch, Rectangle
 
 from .. import experiments, student_code
-from ..figures.common import TrialLine, trial_column
-from ..plotting import COLORS
+from ..figures.delay import DELAY_LINES, DelayPanels, delay_panels
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
-from .panels import DATA_UNDER_LINES, reuse_panels
+from .panels import reuse_panels
 from .sliders import float_slider, starting_value
 from .student_functions import RERUN, checked_function, refiltered, whose
 
@@ -50,28 +45,8 @@ WINDOW = 4.0
 #: The question's sensor: vision alone.
 SENSORS = ("vision",)
 
-# gid of each line → (axes index, role, legend label). The gids let tests find them.
-_LINES: dict[str, TrialLine] = {
-    "vision": (0, "vision", "vision, delayed  $y_{j-δ}$"),
-    "truth": (0, "truth", "true position"),
-    "delayed": (0, "estimate", "delayed estimate  $\\hat z_{j-δ}$"),
-    "prediction": (0, "prediction", "compensated  $z^*_j = A^δ\\,\\hat z_{j-δ}$"),
-    "delayed-error": (1, "estimate", "delayed estimate error"),
-    "prediction-error": (1, "prediction", "compensated error"),
-}
-_SPAN = "nothing-yet"
-_SPAN_STYLE = {"color": COLORS["vision"], "alpha": 0.2, "linewidth": 0, "gid": _SPAN,
-               "zorder": DATA_UNDER_LINES}
 #: Smallest y half-range (in units of the flight's amplitude) of each axes.
 _FLOORS = (1.5, 0.8)
-
-
-class _Panels(NamedTuple):
-    """The axes :func:`draw_delay` builds on a figure and the lines it fills, by gid."""
-
-    axes: tuple[Axes, Axes]
-    lines: dict[str, Line2D]
-    spans: tuple[Rectangle, Rectangle]
 
 
 def draw_delay(figure: Figure, *, delay: float, scenario: Scenario = DEFAULT,
@@ -215,7 +190,7 @@ def _draw_tracking(figure: Figure, delay: float, tracking: experiments.Tracking,
         values = values[shown]
         panels.lines[gid].set_data(scenario.times[shown], values)
         if np.any(np.isfinite(values)):
-            index = _LINES[gid][0]
+            index = DELAY_LINES[gid][0]
             largest[index] = max(largest[index], float(np.nanmax(np.abs(values))))
     for ax, span, floor, extent in zip(panels.axes, panels.spans, _FLOORS, largest,
                                        strict=True):
@@ -247,35 +222,9 @@ def _significant(value: float) -> str:
                                       fractional=False, trim="k").rstrip(".")
 
 
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build the two axes of :func:`draw_delay` on the empty ``figure``, lines empty."""
-    axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
-    figure.subplots_adjust(top=0.91, bottom=0.1, hspace=0.12)
-    top, bottom = axes
-    # The notebooks' painter of a trial's signals over its errors, with no data yet.
-    lines = trial_column(top, bottom, np.empty(0), _LINES, error_linewidth=1.2,
-                         zero_line_first=False)
-    handles = [lines[gid] for gid, (index, _, _) in _LINES.items() if index == 0]
-    handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
-                         label="nothing has arrived yet"))
-    figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.995), ncol=5,
-                  fontsize=8, handlelength=2.2, columnspacing=1.2, markerscale=2.5)
-    top.set_ylabel("position (cm)")
-    # Under the band and the lines (above the grid's zorder 1.5): a fixed text painted
-    # before what a move changes stays in the cached layer; above the band it would be
-    # repainted with it on every move (the band's extent is its whole axes). The band
-    # reaches this corner only when the delay spans most of the window shown (a short
-    # trial); the text then shows through it.
-    bottom.text(0.99, 0.95, "error = estimate − true position", transform=bottom.transAxes,
-                ha="right", va="top", fontsize=8, zorder=(1.5 + DATA_UNDER_LINES) / 2)
-    bottom.set_xlabel("time (s)")
-    bottom.set_ylabel("error (cm)")
-    bottom.set_xlim(0.0, min(WINDOW, scenario.duration))
-    figure.align_ylabels(axes)
-    spans = tuple(ax.axvspan(0.0, 0.0, **_SPAN_STYLE) for ax in axes)
-    for ax in axes:
-        ax.set_xlim(0.0, min(WINDOW, scenario.duration))  # axvspan would widen them
-    return _Panels((top, bottom), lines, spans)
+def _build(figure: Figure, scenario: Scenario) -> DelayPanels:
+    """The explorer's panels on the empty ``figure``, by notebook 05's painter of them."""
+    return delay_panels(figure, min(WINDOW, scenario.duration))
 
 
 def explore_delay(scenario: Scenario = DEFAULT, *, filter: Callable | None = None,

@@ -19,30 +19,21 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
-from matplotlib.text import Annotation
 
 from .. import experiments, validation
-from ..plotting import COLORS, plot_band
+from ..figures.fusion import (  # noqa: F401  (SHARES_TITLE: tests find it here)
+    SHARES_TITLE,
+    FusionPanels,
+    fusion_panels,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
-from .common import (
-    TrialLine,
-    TrialPanels,
-    build_trial_panels,
-    estimate_lines,
-    legend_handles,
-    position_shares,
-    significant,
-    trial_numbers,
-)
-from .panels import DATA_UNDER_LINES, pin_axis_labels, reuse_panels
+from .common import estimate_lines, position_shares, significant, trial_numbers
+from .panels import pin_axis_labels, reuse_panels
 from .sliders import float_slider, starting_value
 from .student_functions import StudentFilter, checked_function, refiltered, whose
 
@@ -53,23 +44,6 @@ FUSED = ("vision", "proprioception")
 SIGMA_RANGE = (0.5, 6.0, 0.25)
 #: How many vision-only runs (one per σ_v, about 0.2 MB each) the explorer keeps.
 VISION_RUNS_KEPT = 16
-
-#: Plotted lines by gid (see :data:`~.common.TrialLine`).
-_LINES: dict[str, TrialLine] = {
-    "vision readings": (0, "vision", "vision readings"),
-    "proprioception readings": (0, "proprioception", "proprioception readings"),
-    "truth": (0, "truth", "true position"),
-    "vision-only": (0, "alternative", "vision-only estimate"),
-    "fused": (0, "estimate", "fused estimate"),
-    "vision-only error": (1, "alternative", None),
-    "fused error": (1, "estimate", None),
-}
-_BAND = "fused band"
-_BAND_LABEL = "fused filter's own ±2 SD"
-#: Title of the right panel; it never changes, so it stays in the cached background. It
-#: names what is drawn, not the rule the shares follow (Going further 5 of notebook 03).
-SHARES_TITLE = "each sense's share\nof the position gain"
-
 
 def unit_noise(scenario: Scenario, noise: np.ndarray | None = None) -> np.ndarray:
     """Unit noise of vision (column 0) and proprioception (column 1), shape (n, 2).
@@ -143,9 +117,9 @@ def draw_fusion(figure: Figure, *, sigma_v: float, sigma_p: float,
 
     Notes
     -----
-    Lines carry a ``gid`` for tests: the keys of ``_LINES`` (``"vision readings"``,
-    ``"proprioception readings"``, ``"truth"``, ``"vision-only"``, ``"fused"``,
-    ``"vision-only error"``, ``"fused error"``); the bars ``"weight vision"`` and
+    Lines carry a ``gid`` for tests: the keys of ``figures.fusion.FUSION_LINES``
+    (``"vision readings"``, ``"proprioception readings"``, ``"truth"``, ``"vision-only"``,
+    ``"fused"``, ``"vision-only error"``, ``"fused error"``); the bars ``"weight vision"`` and
     ``"weight proprioception"``.
 
     Raises
@@ -196,48 +170,11 @@ def _draw(figure: Figure, *, sigma_v: float, sigma_p: float, scenario: Scenario,
     return f"{trial_numbers(scenario, sigma_v, sigma_p, vision, fused)} Filter: {whose(filter)}."
 
 
-class _Panels(NamedTuple):
-    """The artists :func:`draw_fusion` builds on a figure and fills on every call."""
-
-    trial: TrialPanels
-    band: FillBetweenPolyCollection
-    bars: tuple[Rectangle, Rectangle]
-    texts: tuple[Annotation, Annotation]
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build the three panels of :func:`draw_fusion` on the empty ``figure``, data empty."""
-    trial = build_trial_panels(figure, scenario, _LINES, width_ratios=(3.4, 1.0),
-                               height_ratios=(1.6, 1.0), top=0.88, wspace=0.25,
-                               signal_limit=1.7 * scenario.amplitude, error_limit=3.5)
-    errors, shares = trial.errors, trial.side
-    times = scenario.times
-    plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
-    band = errors.collections[-1]
-    band.set_gid(_BAND)
-    band.set_zorder(DATA_UNDER_LINES)
-    figure.legend(handles=[*legend_handles(trial, _LINES), band], loc="upper left",
-                  bbox_to_anchor=(0.07, 0.99), ncol=3, fontsize=8, markerscale=2.5)
-    errors.set_yticks([-2, 0, 2])
-
-    names = ("vision", "proprioception")
-    bars = shares.bar([0, 1], [0.5, 0.5], color=[COLORS[name] for name in names],
-                      edgecolor="black", linewidth=0.6, zorder=DATA_UNDER_LINES)
-    texts = []
-    for bar, name in zip(bars, names, strict=True):
-        bar.set_gid(f"weight {name}")
-        texts.append(shares.annotate("", (bar.get_x() + bar.get_width() / 2, 0.5),
-                                     xytext=(0, 3), textcoords="offset points", ha="center",
-                                     fontsize=9))
-    shares.set_xticks([0, 1], ["vision", "proprio-\nception"])
-    shares.set_ylim(0.0, 1.1)
-    shares.set_yticks([0.0, 0.25, 0.5, 0.75, 1.0])
-    shares.set_ylabel("share of the position correction")
-    # Lifted clear of the axes area, which the bars (clipped to it) repaint on every
-    # move: at the default pad the title would be repainted with them.
-    shares.set_title(SHARES_TITLE, fontsize=10, pad=12)
+def _build(figure: Figure, scenario: Scenario) -> FusionPanels:
+    """The explorer's panels on the empty ``figure``, by its painter in figures/."""
+    panels = fusion_panels(figure, scenario.times, scenario.duration, scenario.amplitude)
     pin_axis_labels(figure)
-    return _Panels(trial, band, tuple(bars), tuple(texts))
+    return panels
 
 
 def describe_fusion(*, sigma_v: float, sigma_p: float) -> str:

@@ -24,20 +24,22 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import MultipleLocator
 
 from .. import experiments, metrics, validation
-from ..plotting import COLORS, style
+from ..figures.initial_covariance import (  # noqa: F401  (the labels, found here too)
+    BAND_LABEL,
+    ESTIMATE_LABEL,
+    TRUTH_LABEL,
+    VISION_LABEL,
+    StartUpPanels,
+    start_up_panels,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
-from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .panels import reuse_panels, set_ylim_in_steps
 from .sliders import log_slider, starting_value
 from .student_functions import checked_function, refiltered, whose
 
@@ -49,54 +51,15 @@ P0_STEPS_PER_DECADE = 4
 #: Time shown (s): the start-up transient and a little of the steady state.
 WINDOW = 2.0
 
-#: Labels of the plotted artists, so tests and readers can find them. Both panels
-#: use the same labels: axes 0 is position, axes 1 velocity.
-TRUTH_LABEL = "truth"
-VISION_LABEL = "noisy vision"
-ESTIMATE_LABEL = "filtered estimate"
-BAND_LABEL = "±2σ of the filter's own variance"
-
-
-
 def shown_steps(scenario: Scenario) -> int:
     """Number of samples drawn: the first :data:`WINDOW` seconds (or the whole trial)."""
     return min(scenario.n_steps, round(WINDOW / scenario.dt) + 1)
 
 
-class _Panels(NamedTuple):
-    """The artists :func:`draw_initial_covariance` builds on a figure and fills on every call."""
-
-    axes: tuple[Axes, Axes]
-    vision: Line2D
-    bands: tuple[FillBetweenPolyCollection, FillBetweenPolyCollection]
-    estimates: tuple[Line2D, Line2D]
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build both panels' artists on the empty ``figure``, with no data yet."""
-    position_ax, velocity_ax = figure.subplots(1, 2)
+def _build(figure: Figure, scenario: Scenario) -> StartUpPanels:
+    """The explorer's panels on the empty ``figure``, by notebook 02's painter of them."""
     times = scenario.times[:shown_steps(scenario)]
-    truth = scenario.truth[:times.size]
-    empty = np.zeros_like(times)
-    vision, = position_ax.plot(times, empty, label=VISION_LABEL, **style("vision"))
-    bands, estimates = [], []
-    for column, ax in enumerate((position_ax, velocity_ax)):
-        bands.append(ax.fill_between(times, empty, empty, color=COLORS["estimate"],
-                                     alpha=0.15, linewidth=0, label=BAND_LABEL,
-                                     zorder=DATA_UNDER_LINES))
-        ax.plot(times, truth[:, column], label=TRUTH_LABEL, **style("truth"))
-        estimates.append(ax.plot(times, empty, label=ESTIMATE_LABEL, **style("estimate"))[0])
-        ax.set_xlim(times[0], times[-1])
-        ax.xaxis.set_major_locator(MultipleLocator(0.5))  # fewer labels: faster redraws
-        ax.set_xlabel("time (s)")
-    position_ax.set_ylabel("position (cm)")
-    velocity_ax.set_ylabel("velocity (cm/s)")
-    speed = scenario.peak_speed
-    velocity_ax.set_ylim(-2.0 * speed, 2.0 * speed)
-    figure.legend(*position_ax.get_legend_handles_labels(), loc="lower center", ncol=4,
-                  fontsize=9, markerscale=3)
-    figure.subplots_adjust(left=0.07, right=0.98, top=0.97, bottom=0.25, wspace=0.22)
-    return _Panels((position_ax, velocity_ax), vision, tuple(bands), tuple(estimates))
+    return start_up_panels(figure, times, scenario.truth[:times.size], scenario.peak_speed)
 
 
 def draw_initial_covariance(figure: Figure, *, p0_variance: float,

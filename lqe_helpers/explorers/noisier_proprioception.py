@@ -21,28 +21,20 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
-from matplotlib.ticker import NullLocator
 
 from .. import experiments, validation
-from ..plotting import COLORS, style
+from ..figures.noisier_proprioception import (  # noqa: F401  (THEORY_TITLE: found here too)
+    THEORY_TITLE,
+    NoisierPanels,
+    noisier_panels,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
 from .cache import LastResults
-from .common import (
-    TrialLine,
-    TrialPanels,
-    build_trial_panels,
-    estimate_lines,
-    legend_handles,
-    position_shares,
-    significant,
-    trial_numbers,
-)
+from .common import estimate_lines, position_shares, significant, trial_numbers
 from .fusion import FUSED, unit_noise, vision_only
 from .panels import pin_axis_labels, reuse_panels
 from .sliders import float_slider
@@ -60,19 +52,6 @@ SIGMA_P_RANGE = (0.5, 30.0, 0.5)
 
 #: σ_p (cm) spanned by the theoretical curve in the right panel.
 CURVE_RANGE = (0.3, 100.0)
-
-#: Title of the right panel; it never changes, so it stays in the cached background.
-THEORY_TITLE = "steady state"
-
-#: Plotted lines of the left column by gid (see :data:`~.common.TrialLine`).
-_LINES: dict[str, TrialLine] = {
-    "truth": (0, "truth", "true position"),
-    "vision-only": (0, "alternative", "vision-only estimate"),
-    "fused": (0, "estimate", "fused estimate (vision + proprioception)"),
-    "vision-only error": (1, "alternative", None),
-    "fused error": (1, "estimate", None),
-}
-
 
 def steady_position_variances(scenario: Scenario, sigma_v: float,
                               sigma_p: np.ndarray) -> tuple[float, np.ndarray]:
@@ -217,42 +196,14 @@ def _weight_text(sigma_p: float, weight_p: float) -> str:
     return f"Proprioception's weight in the steady state: {significant(100 * weight_p, 3)} %."
 
 
-class _Panels(NamedTuple):
-    """The artists :func:`draw_noisier_proprioception` builds and fills on every call."""
-
-    trial: TrialPanels
-    marker: Line2D
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panels:
-    """Build the three panels of :func:`draw_noisier_proprioception` on the empty ``figure``."""
-    trial = build_trial_panels(figure, scenario, _LINES, width_ratios=(2.4, 1.0),
-                               height_ratios=(1.5, 1.0), top=0.9, wspace=0.3,
-                               signal_limit=1.4 * scenario.amplitude, error_limit=2.5)
-    figure.legend(handles=legend_handles(trial, _LINES), loc="upper left",
-                  bbox_to_anchor=(0.07, 0.99), ncol=3, fontsize=8)
-
-    theory = trial.side
-    theory.set_title(THEORY_TITLE, fontsize=10)
+def _build(figure: Figure, scenario: Scenario) -> NoisierPanels:
+    """The explorer's panels on the empty ``figure``, by its painter in figures/."""
     curve_sigma = np.geomspace(*CURVE_RANGE, 120)
     level, curve = steady_position_variances(scenario, scenario.sigma_v, curve_sigma)
-    theory.axhline(level, **style("alternative", gid="theory vision-only",
-                                  label="vision only"))
-    theory.plot(curve_sigma, curve, **style("estimate", gid="theory fused", label="fused"))
-    (marker,) = theory.plot([], [], gid="theory now", linestyle="none", marker="o",
-                            markersize=7, color=COLORS["estimate"], label="slider's σ_p")
-    theory.set_xscale("log")
-    theory.set_xlim(*CURVE_RANGE)
-    # Plain labels, as in the notebook's Figure 3 (mathtext powers of ten render slowly).
-    ticks = [0.3, 1.0, 3.0, 10.0, 30.0, 100.0]
-    theory.set_xticks(ticks, [f"{tick:g}" for tick in ticks])
-    theory.xaxis.set_minor_locator(NullLocator())
-    theory.set_ylim(0.0, 1.15 * level)
-    theory.set_xlabel("σ_p (cm), log scale")
-    theory.set_ylabel("steady-state position variance (cm²)")
-    theory.legend(loc="lower right", fontsize=8)
+    panels = noisier_panels(figure, scenario.times, scenario.duration, scenario.amplitude,
+                            curve_sigma, level, curve)
     pin_axis_labels(figure)
-    return _Panels(trial, marker)
+    return panels
 
 
 def describe_noisier_proprioception(*, sigma_p: float, scenario: Scenario = DEFAULT,

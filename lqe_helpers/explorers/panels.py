@@ -4,8 +4,10 @@ Building a figure's axes, ticks and legends costs more than most filter runs, so
 drawing function builds its panels once per figure with :func:`reuse_panels` and on
 later calls only replaces the data of the same artists; :func:`pin_axis_labels`
 saves the label placement of panels whose ticks never change. Axis limits that change
-in steps (:func:`set_ylim_in_steps`) and bands above the grid (:data:`DATA_UNDER_LINES`)
-keep the repaint of a move small (:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
+in steps (:func:`set_ylim_in_steps`) and bands above the grid
+(:data:`lqe_helpers.plotting.DATA_UNDER_LINES`, which the painters in
+:mod:`lqe_helpers.figures` give them) keep the repaint of a move small
+(:class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
 """
 
 from __future__ import annotations
@@ -20,12 +22,6 @@ from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
 from .. import validation
-
-#: zorder of bands, bars and spans that a slider changes: above the grid and ticks
-#: (1.5, matplotlib's ``axes.axisbelow: line``) and below lines (2). At the default
-#: zorder 1 they would lie under the grid, and every move would repaint each axis
-#: with its tick labels (see :class:`~lqe_helpers.explorers.layers.LayeredCanvas`).
-DATA_UNDER_LINES = 1.6
 
 #: Whatever a panel builder returns: artists, possibly in tuples, lists or dicts.
 Panels = TypeVar("Panels")

@@ -22,19 +22,22 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import partial
-from typing import NamedTuple
 
 import numpy as np
-from matplotlib.axes import Axes
-from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
-from matplotlib.lines import Line2D
 
 from .. import experiments, metrics, validation
-from ..plotting import COLORS, label_time_position, style
+from ..figures.vision import (  # noqa: F401  (the labels: tests and readers find them here)
+    BAND_LABEL,
+    ESTIMATE_LABEL,
+    TRUTH_LABEL,
+    VISION_LABEL,
+    VisionPanel,
+    vision_panel,
+)
 from ..scenario import DEFAULT, Scenario
 from .base import Explorer, with_explorer_seed
-from .panels import DATA_UNDER_LINES, reuse_panels, set_ylim_in_steps
+from .panels import reuse_panels, set_ylim_in_steps
 from .sliders import float_slider, starting_value
 from .student_functions import checked_function, refiltered, whose
 
@@ -43,37 +46,9 @@ SIGMA_V_RANGE = (0.1, 10.0)
 #: Slider step for σ_v (cm).
 SIGMA_V_STEP = 0.1
 
-#: Labels of the plotted artists, so tests and readers can find them.
-TRUTH_LABEL = "true position"
-VISION_LABEL = "noisy vision"
-ESTIMATE_LABEL = "filtered estimate"
-BAND_LABEL = "±2σ of the filter's own variance"
-
-
-class _Panel(NamedTuple):
-    """The artists :func:`draw_vision` builds on a figure and fills on every call."""
-
-    ax: Axes
-    vision: Line2D
-    band: FillBetweenPolyCollection
-    estimate: Line2D
-
-
-def _build(figure: Figure, scenario: Scenario) -> _Panel:
-    """Build the artists on the empty ``figure``, with no data yet."""
-    ax = figure.add_subplot()
-    times = scenario.times
-    vision, = ax.plot(times, np.zeros_like(times), label=VISION_LABEL, **style("vision"))
-    band = ax.fill_between(times, times, times, color=COLORS["estimate"], alpha=0.15,
-                           linewidth=0, label=BAND_LABEL, zorder=DATA_UNDER_LINES)
-    ax.plot(times, scenario.truth[:, 0], label=TRUTH_LABEL, **style("truth"))
-    estimate, = ax.plot(times, np.zeros_like(times), label=ESTIMATE_LABEL, **style("estimate"))
-    ax.set_xlim(0.0, scenario.duration)
-    label_time_position(ax)
-    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4, fontsize=9,
-              markerscale=3)
-    figure.subplots_adjust(left=0.08, right=0.98, top=0.97, bottom=0.27)
-    return _Panel(ax, vision, band, estimate)
+def _build(figure: Figure, scenario: Scenario) -> VisionPanel:
+    """The explorer's panel on the empty ``figure``, by notebook 01's painter of it."""
+    return vision_panel(figure, scenario.times, scenario.truth[:, 0], scenario.duration)
 
 
 def draw_vision(figure: Figure, *, sigma_v: float, scenario: Scenario = DEFAULT,

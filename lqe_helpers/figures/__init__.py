@@ -7,6 +7,9 @@ importable from here (``figures.delay_figure(...)``) and lives in the module of 
 notebook, mirroring :mod:`lqe_helpers.explorers`: ``background`` (00), ``vision`` (01),
 ``initial_covariance`` (02), ``fusion`` (03), ``noisier_proprioception`` (04),
 ``delay`` (05), ``bias`` (06); ``common`` holds the figures and pieces several share.
+Each module also holds the painter of its notebook's explorer (``vision_panel``,
+``fusion_panels``, …, taking the Figure to draw on): it builds the explorer's artists once,
+with no data, and :mod:`lqe_helpers.explorers` refills them on every slider move.
 Nothing runs on import.
 """
 
@@ -26,8 +29,13 @@ from .bias import (
     noise_sweep_figure,
 )
 from .common import paired_mse_figure, tracking_comparison_figure
-from .delay import delay_figure, delay_sweep_figure, prediction_error_sources_figure
-from .fusion import frequency_response_figure, fusion_trial_figure
+from .delay import (
+    delay_figure,
+    delay_sweep_figure,
+    late_eye_figure,
+    prediction_error_sources_figure,
+)
+from .fusion import frequency_response_figure
 from .initial_covariance import (
     belief_and_error_figure,
     gains_figure,
@@ -49,11 +57,11 @@ __all__ = [
     "drift_figure",
     "estimate_error_figure",
     "frequency_response_figure",
-    "fusion_trial_figure",
     "gains_figure",
     "jerk_choice_figure",
     "jerk_sweep_figure",
     "lag_figure",
+    "late_eye_figure",
     "mse_intervals_figure",
     "noise_sweep_figure",
     "open_loop_figure",

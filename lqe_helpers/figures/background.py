@@ -1,13 +1,27 @@
-"""Figures of notebook 00 (the background model): eyes closed, the choice of σ_j, Q's sweep."""
+"""Figures of notebook 00 (the background model): eyes closed, the choice of σ_j, Q's sweep.
+
+Also the painter of notebook 00's explorer (:func:`background_panels`): built once with no
+data, its lines refilled by :mod:`lqe_helpers.explorers.background` on every slider move.
+"""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
-from matplotlib.ticker import NullFormatter
+from matplotlib.lines import Line2D
+from matplotlib.ticker import (
+    FixedLocator,
+    FuncFormatter,
+    MultipleLocator,
+    NullFormatter,
+    NullLocator,
+)
 
-from ..plotting import COLORS, style
+from ..plotting import COLORS, label_time_position, style
 from .common import (
     errorbar_intervals,
     interval_arrays,
@@ -314,3 +328,76 @@ def jerk_choice_figure(jerk_stds: np.ndarray, log_likelihood: np.ndarray,
     axes[1].legend(loc="upper right", fontsize=8)
     fig.tight_layout()
     return fig
+
+
+#: Titles of the explorer's two panels; they never change (the numbers go beside the figure).
+GROWTH_TITLE = "Uncertainty once the measurements stop"
+TRACKING_TITLE = "Tracking"
+#: Gap (points) between a panel and its title: wide enough that the title is not
+#: painted again with the top spine, which every move repaints over the curves.
+TITLE_PAD = 10.0
+#: Labels of the explorer's artists, so tests and readers can find them.
+GROWTH_LABEL = "2σ at this σ_j"
+REFERENCE_LABEL = "2σ at the scenario's σ_j"
+AMPLITUDE_LABEL = "flight amplitude"
+VISION_LABEL = "vision"
+TRUTH_LABEL = "true path"
+ESTIMATE_LABEL = "filtered estimate"
+
+
+class BackgroundPanels(NamedTuple):
+    """The artists :func:`background_panels` draws; the explorer refills the last three."""
+
+    axes: tuple[Axes, Axes]
+    growth: Line2D
+    vision: Line2D
+    estimate: Line2D
+
+
+def background_panels(figure: Figure, reference_times: np.ndarray,
+                      reference_two_sigma: np.ndarray, times: np.ndarray, truth: np.ndarray,
+                      *, amplitude: float, growth_duration: float,
+                      window: tuple[float, float]) -> BackgroundPanels:
+    """Notebook 00's explorer on the empty ``figure``: fixed artists drawn, the rest empty.
+
+    Left: 2σ (cm) of the predicted position against the time since the last measurement
+    (0 to ``growth_duration`` s, log scale), the reference curve ``reference_two_sigma``
+    (cm, shape (r,) at ``reference_times``) and an empty curve for the slider's σ_j.
+    Right: the true path ``truth`` (cm, shape (n,) at ``times`` in s) over ``window`` (s)
+    with empty vision and estimate lines. ``amplitude`` (cm) marks the left panel and
+    scales the right one.
+    """
+    growth_ax, track_ax = figure.subplots(1, 2, gridspec_kw={"width_ratios": [1, 1.35]})
+    growth_ax.plot(reference_times, reference_two_sigma,
+                   **style("reference", label=REFERENCE_LABEL))
+    growth, = growth_ax.plot(reference_times, np.ones_like(reference_times),
+                             **style("prediction", label=GROWTH_LABEL))
+    growth_ax.axhline(amplitude, color=COLORS["truth"], linewidth=0.8, label=AMPLITUDE_LABEL)
+    growth_ax.set_yscale("log")
+    growth_ax.set_ylim(1e-2, 1e3)
+    # Decades only, as plain numbers: minor ticks and mathtext labels would double
+    # the time a slider move takes to render.
+    growth_ax.yaxis.set_major_locator(FixedLocator(np.logspace(-2, 3, 6)))
+    growth_ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+    growth_ax.yaxis.set_minor_locator(NullLocator())
+    growth_ax.set_xlim(0, growth_duration)
+    growth_ax.set_xlabel("time since the last measurement (s)")
+    growth_ax.set_ylabel("2σ of predicted position (cm)")
+    growth_ax.set_title(GROWTH_TITLE, fontsize=10, pad=TITLE_PAD)
+    # Legends below the panels, never over a moving curve: a legend a curve passes
+    # under has to be painted again on every slider move.
+    growth_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=2)
+
+    shown = (times >= window[0]) & (times <= window[1])
+    empty = np.zeros(int(shown.sum()))
+    vision, = track_ax.plot(times[shown], empty, **style("vision", label=VISION_LABEL))
+    track_ax.plot(times[shown], truth[shown], **style("truth", label=TRUTH_LABEL))
+    estimate, = track_ax.plot(times[shown], empty, **style("estimate", label=ESTIMATE_LABEL))
+    track_ax.set_ylim(-1.7 * amplitude, 1.7 * amplitude)
+    track_ax.set_xlim(*window)
+    track_ax.xaxis.set_major_locator(MultipleLocator(1.0))  # fewer labels: faster redraws
+    label_time_position(track_ax)
+    track_ax.set_title(TRACKING_TITLE, fontsize=10, pad=TITLE_PAD)
+    track_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize=8, ncols=3)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.25, wspace=0.22)
+    return BackgroundPanels((growth_ax, track_ax), growth, vision, estimate)

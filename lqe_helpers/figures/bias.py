@@ -1,12 +1,22 @@
-"""Figures of notebook 06 (bias and input): the bias learned, the signal, dead reckoning."""
+"""Figures of notebook 06 (bias and input): the bias learned, the signal, dead reckoning.
+
+Also the painter of notebook 06's explorer (:func:`bias_panels`): built once with no data,
+refilled by :mod:`lqe_helpers.explorers.bias` on every slider move.
+"""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
 
-from ..plotting import COLORS, style
+from ..plotting import COLORS, DATA_UNDER_LINES, label_time_position, style
 from .common import errorbar_intervals, first_seconds, label_axes, plot_series
 
 _LEGEND_UPPER_RIGHT = {"loc": "upper right", "fontsize": 8}
@@ -230,3 +240,76 @@ def bias_settling_figure(times: np.ndarray, mean_errors: dict[str, np.ndarray],
                "The filter's σ of the bias, by vision noise", **_whole_trial_log(times))
     fig.tight_layout()
     return fig
+
+
+#: Fixed y range of the explorer's bias panel (cm/s²): every slider value fits.
+BIAS_AXIS = (-80.0, 80.0)
+#: Spacing of the bias panel's y ticks (cm/s²).
+BIAS_TICK = 40.0
+#: Labels of the explorer's artists, so tests and readers can find them.
+TRUE_BIAS_LABEL = "true bias"
+BIAS_ESTIMATE_LABEL = "estimated bias"
+BIAS_BAND_LABEL = "±2σ"
+TRUTH_LABEL = "true path"
+VISION_LABEL = "vision"
+ESTIMATE_LABEL = "filtered estimate"
+DEAD_RECKONING_LABEL = "dead reckoning"
+#: Titles of the explorer's two panels; they never change (cached background).
+BIAS_TITLE = "bias of the acceleration signal"
+PATH_TITLE = "position of the hand"
+
+
+class BiasPanels(NamedTuple):
+    """The artists :func:`bias_panels` draws; the explorer refills all of them."""
+
+    axes: tuple[Axes, Axes]
+    band: FillBetweenPolyCollection
+    true_bias: Line2D
+    bias_estimate: Line2D
+    vision: Line2D
+    estimate: Line2D
+    dead_reckoning: Line2D
+
+
+def bias_panels(figure: Figure, times: np.ndarray, truth: np.ndarray, *, amplitude: float,
+                window: float) -> BiasPanels:
+    """Notebook 06's explorer on the empty ``figure``: the bias (left) and the path (right).
+
+    ``times`` (s) and ``truth`` (true position, cm), shape (n,) each, the samples shown;
+    ``window`` (s) the time axis' end; ``amplitude`` (cm) scales the path's axis.
+    """
+    bias_ax, path_ax = figure.subplots(1, 2)
+    empty = np.zeros_like(times)
+    band = bias_ax.fill_between(times, empty, empty, color=COLORS["estimate"], alpha=0.15,
+                                linewidth=0, label=BIAS_BAND_LABEL, zorder=DATA_UNDER_LINES)
+    true_bias, = bias_ax.plot(times, empty, **style("truth", label=TRUE_BIAS_LABEL))
+    bias_estimate, = bias_ax.plot(times, empty, **style("estimate", label=BIAS_ESTIMATE_LABEL))
+    bias_ax.set_ylim(*BIAS_AXIS)
+    bias_ax.set_xlim(0, window)
+    # Fewer tick labels than matplotlib's default: text is most of a redraw's cost.
+    bias_ax.yaxis.set_major_locator(MultipleLocator(BIAS_TICK))
+    bias_ax.set_xlabel("time (s)")
+    bias_ax.set_ylabel("bias (cm/s²)")
+    bias_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=3)
+    # Lifted clear of the axes area, which the band (clipped to it) repaints on every
+    # move: at the default pad the title would be repainted with it.
+    bias_ax.set_title(BIAS_TITLE, fontsize=10, pad=10)
+
+    vision, = path_ax.plot(times, empty, **style("vision", label=VISION_LABEL))
+    path_ax.plot(times, truth, **style("truth", label=TRUTH_LABEL))
+    estimate, = path_ax.plot(times, empty, **style("estimate", label=ESTIMATE_LABEL))
+    dead_reckoning, = path_ax.plot(times, empty,
+                                   **style("alternative", label=DEAD_RECKONING_LABEL))
+    limit = 2.0 * amplitude
+    path_ax.set_ylim(-limit, limit)
+    path_ax.set_xlim(0, window)
+    path_ax.yaxis.set_major_locator(MultipleLocator(amplitude))
+    for ax in (bias_ax, path_ax):
+        ax.xaxis.set_major_locator(MultipleLocator(1.0))
+    label_time_position(path_ax)
+    path_ax.set_title(PATH_TITLE, fontsize=10, pad=10)
+    path_ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.13), fontsize=8, ncols=4,
+                   markerscale=2, columnspacing=1.0, handlelength=1.8)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.92, bottom=0.22, wspace=0.2)
+    return BiasPanels((bias_ax, path_ax), band, true_bias, bias_estimate, vision,
+                      estimate, dead_reckoning)

@@ -2,19 +2,21 @@
 
 The figures: :func:`tracking_comparison_figure` (estimates beside the truth, their errors
 below; notebooks 01, 03, 04, 05; its painter :func:`trial_column` draws the explorers'
-trials of 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
+trials of 01, 03, 04 and 05 too) and :func:`paired_mse_figure` (one point per Monte
 Carlo run; 01, 03, 04, 05, 06). The pieces: series drawn in their roles
 (:func:`plot_series`), axes labelled in one call (:func:`label_axes`), Monte Carlo
 means with their 95 % intervals as error bars or a band (:func:`errorbar_intervals`,
 :func:`mean_band`), values marked by a labelled vertical line (:func:`mark_values`), a
 legend above a full panel (:func:`legend_above`), plain tick labels on a log axis
-(:func:`plain_log_ticks`) and the first seconds of a trial (:func:`first_seconds`).
+(:func:`plain_log_ticks`), the first seconds of a trial (:func:`first_seconds`) and the
+explorers' trial of 03 and 04 beside a side panel (:func:`trial_panels`).
 Nothing runs on import.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -177,22 +179,24 @@ def legend_above(ax: Axes, title: str = "") -> None:
     ax.set_title(title, pad=22)
 
 
-def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
+def trial_column(signals: Axes, errors: Axes | None, times: np.ndarray,
                  lines: Mapping[str, TrialLine],
                  values: Mapping[str, np.ndarray] | None = None, *,
                  error_linewidth: float, zero_line_first: bool) -> dict[str, Line2D]:
     """Draw one trial's signals over its errors: the one painter of that picture.
 
-    Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 and
-    :meth:`lqe_helpers.experiments.Tracking.figure`) and by the explorers of 03, 04 and 05
-    (:func:`lqe_helpers.explorers.common.build_trial_panels`,
-    :func:`lqe_helpers.explorers.delay.draw_delay`), which draw with no data and then
-    refill these lines on every slider move.
+    Used by :func:`tracking_comparison_figure` (notebooks 01, 03, 04, 05 through
+    :meth:`lqe_helpers.experiments.Tracking.figure` and
+    :meth:`lqe_helpers.experiments.DelayedTracking.comparison_figure`) and by the painters of
+    the explorers of 01, 03, 04 and 05 (:func:`lqe_helpers.figures.vision.vision_panel`,
+    signals only; :func:`trial_panels`; :func:`lqe_helpers.figures.delay.delay_panels`),
+    which draw with no data; the explorers refill these lines on every slider move.
 
     Parameters
     ----------
     signals, errors : matplotlib.axes.Axes
-        The top (position, cm) and bottom (estimate − true position, cm) panels.
+        The top (position, cm) and bottom (estimate − true position, cm) panels;
+        ``errors`` None for a trial's signals alone (every line on panel 0).
     times : array_like, shape (n,)
         Sample times (s).
     lines : mapping of str to (panel, role, label)
@@ -211,10 +215,18 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
     -------
     dict of str to Line2D
         The drawn lines by gid.
+
+    Raises
+    ------
+    ValueError
+        If ``errors`` is None and a line is on panel 1.
     """
     times = np.asarray(times, dtype=float)
     panels = (signals, errors)
-    if zero_line_first:
+    if errors is None and any(panel != 0 for panel, _, _ in lines.values()):
+        raise ValueError(f"lines must all be on panel 0 when errors is None, got "
+                         f"{[gid for gid, (panel, _, _) in lines.items() if panel != 0]}")
+    if zero_line_first and errors is not None:
         errors.axhline(0.0, **style("truth", linewidth=0.8))
     drawn = {}
     for gid, (panel, role, label) in lines.items():
@@ -222,9 +234,54 @@ def trial_column(signals: Axes, errors: Axes, times: np.ndarray,
         y = np.zeros_like(times) if values is None else np.asarray(values[gid], dtype=float)
         (drawn[gid],) = panels[panel].plot(times, y, **style(role, gid=gid, label=label,
                                                              **extra))
-    if not zero_line_first:
+    if not zero_line_first and errors is not None:
         errors.axhline(0.0, **style("truth", linewidth=0.8))
     return drawn
+
+
+class TrialPanels(NamedTuple):
+    """A trial's signals (top left) and errors (bottom left), a side panel, the lines."""
+
+    signals: Axes
+    errors: Axes
+    side: Axes
+    lines: dict[str, Line2D]
+
+
+def trial_panels(figure: Figure, duration: float, times: np.ndarray,
+                 lines: Mapping[str, TrialLine], *, width_ratios: tuple[float, float],
+                 height_ratios: tuple[float, float], top: float, wspace: float,
+                 signal_limit: float, error_limit: float) -> TrialPanels:
+    """One trial over ``times`` (s) beside a side panel, on an empty figure (03, 04 explorers).
+
+    The left column holds the signals (position, ±``signal_limit`` cm) above the
+    errors (estimate − true position, ±``error_limit`` cm, with a zero line) over 0 to
+    ``duration`` s; each entry of ``lines`` becomes a line of zeros, its key as gid,
+    waiting for data, drawn by :func:`trial_column`. The caller adds the legend and
+    fills the side panel.
+    """
+    grid = figure.add_gridspec(2, 2, width_ratios=width_ratios, height_ratios=height_ratios,
+                               left=0.07, right=0.98, bottom=0.1, top=top,
+                               hspace=0.1, wspace=wspace)
+    signals = figure.add_subplot(grid[0, 0])
+    errors = figure.add_subplot(grid[1, 0], sharex=signals)
+    side = figure.add_subplot(grid[:, 1])
+    drawn = trial_column(signals, errors, times, lines, error_linewidth=1.0,
+                         zero_line_first=False)
+    signals.set_ylim(-signal_limit, signal_limit)
+    signals.set_ylabel("position (cm)")
+    signals.tick_params(labelbottom=False)
+    errors.set_ylim(-error_limit, error_limit)
+    errors.set_xlim(0.0, duration)
+    errors.set_xlabel("time (s)")
+    errors.set_ylabel("error (cm)")
+    figure.align_ylabels((signals, errors))
+    return TrialPanels(signals, errors, side, drawn)
+
+
+def legend_handles(panels: TrialPanels, lines: Mapping[str, TrialLine]) -> list[Line2D]:
+    """The lines of ``panels`` that ``lines`` gives a legend label, in its order."""
+    return [panels.lines[gid] for gid, (_, _, label) in lines.items() if label is not None]
 
 
 def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,

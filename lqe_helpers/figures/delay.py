@@ -1,13 +1,32 @@
-"""Figures of notebook 05 (sensory delay): the late signal, compensation, and its limits."""
+"""Figures of notebook 05 (sensory delay): the late signal, compensation, and its limits.
+
+Also the painter of notebook 05's explorer (:func:`delay_panels`): one trial's signals
+over its errors by :func:`~lqe_helpers.figures.common.trial_column` (the painter of the
+notebook's Figure 3), built once with no data and refilled by
+:mod:`lqe_helpers.explorers.delay` on every slider move.
+"""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.patches import Patch, Rectangle
 
-from ..plotting import COLORS, style
-from .common import interval_arrays, label_axes, mean_band, plot_series
+from ..plotting import COLORS, DATA_UNDER_LINES, style
+from .common import (
+    TrialLine,
+    interval_arrays,
+    label_axes,
+    mean_band,
+    plot_series,
+    tracking_comparison_figure,
+    trial_column,
+)
 
 
 def delay_figure(times: np.ndarray, truth: np.ndarray, delayed_readings: np.ndarray,
@@ -215,3 +234,87 @@ def prediction_error_sources_figure(theory_delays: np.ndarray, theory: np.ndarra
                xlim=(x[0], x[-1]), ylim=(1e-4 * theory.min(), 10.0 * theory.max()),
                legend={"loc": "upper left", "fontsize": 9})
     return fig
+
+
+def late_eye_figure(times: np.ndarray, truth: np.ndarray, delayed: np.ndarray,
+                    compensated: np.ndarray, late_eye: np.ndarray, title: str = "") -> Figure:
+    """Notebook 05's Figure 3: the delayed and compensated estimates and a perfect but late eye.
+
+    Parameters
+    ----------
+    times : array_like, shape (n,)
+        Sample times (s).
+    truth, delayed, compensated, late_eye : array_like, shape (n,)
+        True position, the delayed estimate ``p̂_{j−δ}``, the compensated ``p*_j`` and the
+        true position seen δ samples late (cm); NaN where nothing has arrived.
+    title : str
+        Title of the top panel.
+
+    Returns
+    -------
+    Figure
+        :func:`~lqe_helpers.figures.common.tracking_comparison_figure` of the three: blue,
+        vermillion and pink dotted on top, their errors below.
+    """
+    return tracking_comparison_figure(times, truth, {
+        r"delayed estimate $\hat p_{j-\delta}$": (delayed, "estimate"),
+        r"compensated $p^*_j$": (compensated, "prediction"),
+        r"perfect but late eye $p_{j-\delta}$": (late_eye, "reference")}, title=title)
+
+
+#: The explorer's lines: gid → (axes index, role, legend label). The gids let tests find
+#: them.
+DELAY_LINES: dict[str, TrialLine] = {
+    "vision": (0, "vision", "vision, delayed  $y_{j-δ}$"),
+    "truth": (0, "truth", "true position"),
+    "delayed": (0, "estimate", "delayed estimate  $\\hat z_{j-δ}$"),
+    "prediction": (0, "prediction", "compensated  $z^*_j = A^δ\\,\\hat z_{j-δ}$"),
+    "delayed-error": (1, "estimate", "delayed estimate error"),
+    "prediction-error": (1, "prediction", "compensated error"),
+}
+_SPAN = "nothing-yet"
+_SPAN_STYLE = {"color": COLORS["vision"], "alpha": 0.2, "linewidth": 0, "gid": _SPAN,
+               "zorder": DATA_UNDER_LINES}
+
+
+class DelayPanels(NamedTuple):
+    """The axes :func:`delay_panels` draws and the lines and spans the explorer refills."""
+
+    axes: tuple[Axes, Axes]
+    lines: dict[str, Line2D]
+    spans: tuple[Rectangle, Rectangle]
+
+
+def delay_panels(figure: Figure, window: float) -> DelayPanels:
+    """Notebook 05's explorer on the empty ``figure``: signals over errors, no data yet.
+
+    The lines of :data:`DELAY_LINES`, a legend above, and in each axes an empty span
+    "nothing has arrived yet"; the time axis spans 0 to ``window`` (s).
+    """
+    axes = figure.subplots(2, 1, sharex=True, gridspec_kw={"height_ratios": [2.2, 1]})
+    figure.subplots_adjust(top=0.91, bottom=0.1, hspace=0.12)
+    top, bottom = axes
+    # The notebooks' painter of a trial's signals over its errors, with no data yet.
+    lines = trial_column(top, bottom, np.empty(0), DELAY_LINES, error_linewidth=1.2,
+                         zero_line_first=False)
+    handles = [lines[gid] for gid, (index, _, _) in DELAY_LINES.items() if index == 0]
+    handles.append(Patch(**{k: v for k, v in _SPAN_STYLE.items() if k != "gid"},
+                         label="nothing has arrived yet"))
+    figure.legend(handles=handles, loc="upper center", bbox_to_anchor=(0.5, 0.995), ncol=5,
+                  fontsize=8, handlelength=2.2, columnspacing=1.2, markerscale=2.5)
+    top.set_ylabel("position (cm)")
+    # Under the band and the lines (above the grid's zorder 1.5): a fixed text painted
+    # before what a move changes stays in the cached layer; above the band it would be
+    # repainted with it on every move (the band's extent is its whole axes). The band
+    # reaches this corner only when the delay spans most of the window shown (a short
+    # trial); the text then shows through it.
+    bottom.text(0.99, 0.95, "error = estimate − true position", transform=bottom.transAxes,
+                ha="right", va="top", fontsize=8, zorder=(1.5 + DATA_UNDER_LINES) / 2)
+    bottom.set_xlabel("time (s)")
+    bottom.set_ylabel("error (cm)")
+    bottom.set_xlim(0.0, window)
+    figure.align_ylabels(axes)
+    spans = tuple(ax.axvspan(0.0, 0.0, **_SPAN_STYLE) for ax in axes)
+    for ax in axes:
+        ax.set_xlim(0.0, window)  # axvspan would widen them
+    return DelayPanels((top, bottom), lines, spans)

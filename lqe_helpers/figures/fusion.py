@@ -1,66 +1,36 @@
-"""Figures of notebook 03 (fusion): one trial of vision alone against vision + proprioception,
-and the settled filters' frequency response (Going further).
+"""Figures of notebook 03 (fusion): the settled filters' frequency response (Going further).
 
-Notebook 04 draws the same comparison with a noisier proprioception. Both notebooks'
-Monte Carlo comparisons use the shared :func:`~lqe_helpers.figures.common.paired_mse_figure`.
+Notebooks 03 and 04 draw one trial of vision alone against vision + proprioception with
+:meth:`lqe_helpers.experiments.Tracking.figure`
+(:func:`~lqe_helpers.figures.common.tracking_comparison_figure`), their Monte Carlo
+comparisons with :func:`~lqe_helpers.figures.common.paired_mse_figure`.
+Also the painter of notebook 03's explorer (:func:`fusion_panels`): the trial by
+:func:`~lqe_helpers.figures.common.trial_panels` beside each sense's share of the gain,
+built once with no data and refilled by :mod:`lqe_helpers.explorers.fusion`.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
+from matplotlib.text import Annotation
 
-from ..plotting import COLORS, style
-from .common import label_axes, mark_values, plain_log_ticks, tracking_comparison_figure
-
-
-def fusion_trial_figure(times: np.ndarray, truth: np.ndarray, vision_only: np.ndarray,
-                        fused: np.ndarray, readings: np.ndarray | None = None,
-                        fused_label: str = "vision + proprioception",
-                        title: str = "") -> Figure:
-    """One trial: the vision-only and the fused estimate beside the truth, their errors below.
-
-    Parameters
-    ----------
-    times : array_like, shape (n,)
-        Sample times (s).
-    truth : array_like, shape (n,)
-        True position (cm).
-    vision_only, fused : array_like, shape (n,)
-        Position estimates (cm) of the vision-only filter (drawn green dash-dotted) and
-        of the fused filter (blue).
-    readings : array_like, shape (n, 2), optional
-        The trial's readings (cm), vision then proprioception, drawn in the top panel.
-    fused_label : str
-        Legend label of the fused estimate (e.g. "vision + noisier proprioception").
-    title : str
-        Title of the top panel (say what changed, e.g. "σ_v = σ_p = 1.5 cm").
-
-    Returns
-    -------
-    Figure
-        :func:`~lqe_helpers.figures.common.tracking_comparison_figure` of the two
-        estimates: lines in the order readings, truth, vision only, fused.
-
-    Raises
-    ------
-    ValueError
-        If ``readings`` is not of shape (n, 2).
-    """
-    shown = None
-    if readings is not None:
-        readings = np.asarray(readings, dtype=float)
-        if readings.shape != (np.size(times), 2):
-            raise ValueError(f"readings must have shape (n, 2) = ({np.size(times)}, 2), "
-                             f"vision then proprioception, got shape {readings.shape}")
-        shown = {"vision readings": (readings[:, 0], "vision"),
-                 "proprioception readings": (readings[:, 1], "proprioception")}
-    estimates = {"vision only": (vision_only, "alternative"), fused_label: (fused, "estimate")}
-    return tracking_comparison_figure(times, truth, estimates, readings=shown, title=title)
-
+from ..plotting import COLORS, DATA_UNDER_LINES, plot_band, style
+from .common import (
+    TrialLine,
+    TrialPanels,
+    label_axes,
+    legend_handles,
+    mark_values,
+    plain_log_ticks,
+    trial_panels,
+)
 
 #: A curve of :func:`frequency_response_figure`: (gain |H|, shape (f,); lead in s, shape
 #: (f,); style role).
@@ -140,3 +110,69 @@ def frequency_response_figure(frequency: np.ndarray, curves: Mapping[str, Respon
                                    if frequency[0] <= tick <= frequency[-1]])
     fig.tight_layout()
     return fig
+
+
+#: The explorer's lines by gid (see :data:`~lqe_helpers.figures.common.TrialLine`).
+FUSION_LINES: dict[str, TrialLine] = {
+    "vision readings": (0, "vision", "vision readings"),
+    "proprioception readings": (0, "proprioception", "proprioception readings"),
+    "truth": (0, "truth", "true position"),
+    "vision-only": (0, "alternative", "vision-only estimate"),
+    "fused": (0, "estimate", "fused estimate"),
+    "vision-only error": (1, "alternative", None),
+    "fused error": (1, "estimate", None),
+}
+_BAND = "fused band"
+_BAND_LABEL = "fused filter's own ±2 SD"
+#: Title of the explorer's right panel; it never changes, so it stays in the cached
+#: background. It names what is drawn, not the rule the shares follow (Going further 5
+#: of notebook 03).
+SHARES_TITLE = "each sense's share\nof the position gain"
+
+
+class FusionPanels(NamedTuple):
+    """The artists :func:`fusion_panels` draws; the explorer refills all of them."""
+
+    trial: TrialPanels
+    band: FillBetweenPolyCollection
+    bars: tuple[Rectangle, Rectangle]
+    texts: tuple[Annotation, Annotation]
+
+
+def fusion_panels(figure: Figure, times: np.ndarray, duration: float,
+                  amplitude: float) -> FusionPanels:
+    """Notebook 03's explorer on the empty ``figure``: a trial and the shares, no data yet.
+
+    Left: the lines of :data:`FUSION_LINES` over ``times`` (s), 0 to ``duration`` s,
+    signals ±1.7 ``amplitude`` (cm), errors with the fused filter's ±2 SD band. Right:
+    one bar per sense for its share of the position correction, its value printed on it.
+    """
+    trial = trial_panels(figure, duration, times, FUSION_LINES, width_ratios=(3.4, 1.0),
+                         height_ratios=(1.6, 1.0), top=0.88, wspace=0.25,
+                         signal_limit=1.7 * amplitude, error_limit=3.5)
+    errors, shares = trial.errors, trial.side
+    plot_band(errors, times, np.zeros_like(times), np.ones_like(times), label=_BAND_LABEL)
+    band = errors.collections[-1]
+    band.set_gid(_BAND)
+    band.set_zorder(DATA_UNDER_LINES)
+    figure.legend(handles=[*legend_handles(trial, FUSION_LINES), band], loc="upper left",
+                  bbox_to_anchor=(0.07, 0.99), ncol=3, fontsize=8, markerscale=2.5)
+    errors.set_yticks([-2, 0, 2])
+
+    names = ("vision", "proprioception")
+    bars = shares.bar([0, 1], [0.5, 0.5], color=[COLORS[name] for name in names],
+                      edgecolor="black", linewidth=0.6, zorder=DATA_UNDER_LINES)
+    texts = []
+    for bar, name in zip(bars, names, strict=True):
+        bar.set_gid(f"weight {name}")
+        texts.append(shares.annotate("", (bar.get_x() + bar.get_width() / 2, 0.5),
+                                     xytext=(0, 3), textcoords="offset points", ha="center",
+                                     fontsize=9))
+    shares.set_xticks([0, 1], ["vision", "proprio-\nception"])
+    shares.set_ylim(0.0, 1.1)
+    shares.set_yticks([0.0, 0.25, 0.5, 0.75, 1.0])
+    shares.set_ylabel("share of the position correction")
+    # Lifted clear of the axes area, which the bars (clipped to it) repaint on every
+    # move: at the default pad the title would be repainted with them.
+    shares.set_title(SHARES_TITLE, fontsize=10, pad=12)
+    return FusionPanels(trial, band, tuple(bars), tuple(texts))

@@ -1,12 +1,22 @@
-"""Figures of notebook 02 (initial covariance): the start-up, the gains, the sweep over P0."""
+"""Figures of notebook 02 (initial covariance): the start-up, the gains, the sweep over P0.
+
+Also the painter of notebook 02's explorer (:func:`start_up_panels`): built once with no
+data, refilled by :mod:`lqe_helpers.explorers.initial_covariance` on every slider move.
+"""
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import MultipleLocator
 
-from ..plotting import COLORS, style
+from ..plotting import COLORS, DATA_UNDER_LINES, style
 from .common import (
     errorbar_intervals,
     first_seconds,
@@ -241,3 +251,49 @@ def p0_sweep_figure(p0_grid: np.ndarray, convergence, start_up, settled, burn_in
     ax_m.set_title("How much it costs, and what stays the same")
     fig.tight_layout()
     return fig
+
+
+#: Labels of the explorer's artists, so tests and readers can find them. Both panels use
+#: the same labels: axes 0 is position, axes 1 velocity.
+TRUTH_LABEL = "truth"
+VISION_LABEL = "noisy vision"
+ESTIMATE_LABEL = "filtered estimate"
+BAND_LABEL = "±2σ of the filter's own variance"
+
+
+class StartUpPanels(NamedTuple):
+    """The artists :func:`start_up_panels` draws; the explorer refills all but the truth."""
+
+    axes: tuple[Axes, Axes]
+    vision: Line2D
+    bands: tuple[FillBetweenPolyCollection, FillBetweenPolyCollection]
+    estimates: tuple[Line2D, Line2D]
+
+
+def start_up_panels(figure: Figure, times: np.ndarray, truth: np.ndarray,
+                    peak_speed: float) -> StartUpPanels:
+    """Notebook 02's explorer on the empty ``figure``: position and velocity, no data yet.
+
+    ``times`` (s), shape (n,); ``truth`` (n, 2 or more): true position (cm) and velocity
+    (cm/s) in columns 0 and 1; ``peak_speed`` (cm/s) sets the velocity axis to ±2×.
+    """
+    position_ax, velocity_ax = figure.subplots(1, 2)
+    empty = np.zeros_like(times)
+    vision, = position_ax.plot(times, empty, label=VISION_LABEL, **style("vision"))
+    bands, estimates = [], []
+    for column, ax in enumerate((position_ax, velocity_ax)):
+        bands.append(ax.fill_between(times, empty, empty, color=COLORS["estimate"],
+                                     alpha=0.15, linewidth=0, label=BAND_LABEL,
+                                     zorder=DATA_UNDER_LINES))
+        ax.plot(times, truth[:, column], label=TRUTH_LABEL, **style("truth"))
+        estimates.append(ax.plot(times, empty, label=ESTIMATE_LABEL, **style("estimate"))[0])
+        ax.set_xlim(times[0], times[-1])
+        ax.xaxis.set_major_locator(MultipleLocator(0.5))  # fewer labels: faster redraws
+        ax.set_xlabel("time (s)")
+    position_ax.set_ylabel("position (cm)")
+    velocity_ax.set_ylabel("velocity (cm/s)")
+    velocity_ax.set_ylim(-2.0 * peak_speed, 2.0 * peak_speed)
+    figure.legend(*position_ax.get_legend_handles_labels(), loc="lower center", ncol=4,
+                  fontsize=9, markerscale=3)
+    figure.subplots_adjust(left=0.07, right=0.98, top=0.97, bottom=0.25, wspace=0.22)
+    return StartUpPanels((position_ax, velocity_ax), vision, tuple(bands), tuple(estimates))

@@ -1,13 +1,32 @@
-"""Figures of notebook 04 (noisier proprioception): how much a worse sense still helps."""
+"""Figures of notebook 04 (noisier proprioception): how much a worse sense still helps.
+
+Also the painter of notebook 04's explorer (:func:`noisier_panels`): the trial by
+:func:`~lqe_helpers.figures.common.trial_panels` beside the steady-state theory, built once
+with no data and refilled by :mod:`lqe_helpers.explorers.noisier_proprioception`.
+"""
 
 from __future__ import annotations
+
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+from matplotlib.ticker import NullLocator
 
 from ..plotting import COLORS, style
-from .common import interval_arrays, label_axes, mark_values, mean_band, plain_log_ticks
+from .common import (
+    TrialLine,
+    TrialPanels,
+    interval_arrays,
+    label_axes,
+    legend_handles,
+    mark_values,
+    mean_band,
+    plain_log_ticks,
+    trial_panels,
+)
 
 
 def proprioception_sweep_figure(sigma_p: np.ndarray, fused, margin, dense_sigma_p: np.ndarray,
@@ -133,3 +152,58 @@ def assumed_noise_figure(assumed_sigma_p: np.ndarray, fused, excess, vision_mse:
     fig.suptitle(f"Misjudging proprioception: true σ_v = {sigma_v} cm, σ_p = {sigma_p} cm "
                  f"({runs} runs)", y=1.0)
     return fig
+
+
+#: Title of the explorer's right panel; it never changes (cached background).
+THEORY_TITLE = "steady state"
+#: The explorer's lines of the left column by gid
+#: (see :data:`~lqe_helpers.figures.common.TrialLine`).
+NOISIER_LINES: dict[str, TrialLine] = {
+    "truth": (0, "truth", "true position"),
+    "vision-only": (0, "alternative", "vision-only estimate"),
+    "fused": (0, "estimate", "fused estimate (vision + proprioception)"),
+    "vision-only error": (1, "alternative", None),
+    "fused error": (1, "estimate", None),
+}
+
+
+class NoisierPanels(NamedTuple):
+    """The artists :func:`noisier_panels` draws; the explorer refills them."""
+
+    trial: TrialPanels
+    marker: Line2D
+
+
+def noisier_panels(figure: Figure, times: np.ndarray, duration: float, amplitude: float,
+                   curve_sigma: np.ndarray, level: float, curve: np.ndarray) -> NoisierPanels:
+    """Notebook 04's explorer on the empty ``figure``: a trial and the theory, no data yet.
+
+    Left: the lines of :data:`NOISIER_LINES` over ``times`` (s), 0 to ``duration`` s,
+    signals ±1.4 ``amplitude`` (cm). Right: the steady-state position variance (cm²) of
+    vision alone (``level``) and fused (``curve`` against ``curve_sigma``, σ_p in cm, log
+    axis), with an empty marker for the slider's σ_p.
+    """
+    trial = trial_panels(figure, duration, times, NOISIER_LINES, width_ratios=(2.4, 1.0),
+                         height_ratios=(1.5, 1.0), top=0.9, wspace=0.3,
+                         signal_limit=1.4 * amplitude, error_limit=2.5)
+    figure.legend(handles=legend_handles(trial, NOISIER_LINES), loc="upper left",
+                  bbox_to_anchor=(0.07, 0.99), ncol=3, fontsize=8)
+
+    theory = trial.side
+    theory.set_title(THEORY_TITLE, fontsize=10)
+    theory.axhline(level, **style("alternative", gid="theory vision-only",
+                                  label="vision only"))
+    theory.plot(curve_sigma, curve, **style("estimate", gid="theory fused", label="fused"))
+    (marker,) = theory.plot([], [], gid="theory now", linestyle="none", marker="o",
+                            markersize=7, color=COLORS["estimate"], label="slider's σ_p")
+    theory.set_xscale("log")
+    theory.set_xlim(curve_sigma[0], curve_sigma[-1])
+    # Plain labels, as in the notebook's Figure 3 (mathtext powers of ten render slowly).
+    ticks = [0.3, 1.0, 3.0, 10.0, 30.0, 100.0]
+    theory.set_xticks(ticks, [f"{tick:g}" for tick in ticks])
+    theory.xaxis.set_minor_locator(NullLocator())
+    theory.set_ylim(0.0, 1.15 * level)
+    theory.set_xlabel("σ_p (cm), log scale")
+    theory.set_ylabel("steady-state position variance (cm²)")
+    theory.legend(loc="lower right", fontsize=8)
+    return NoisierPanels(trial, marker)

@@ -2,17 +2,70 @@
 
 :func:`estimate_error_figure` (errors with the filter's own band and the systematic error)
 and :func:`lag_figure` (noise-free outputs of the filter and a smoother beside the truth:
-who lags, who leads).
+who lags, who leads); :func:`vision_panel`, the painter of notebook 01's explorer: one trial's
+signals drawn by :func:`~lqe_helpers.figures.common.trial_column` (the painter of the
+notebook's Figures 1–2) with the filter's ±2σ band, built once and refilled by
+:mod:`lqe_helpers.explorers.vision` on every slider move.
 """
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.collections import FillBetweenPolyCollection
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
 
-from ..plotting import COLORS, style
-from .common import label_axes, plot_series
+from ..plotting import COLORS, DATA_UNDER_LINES, label_time_position, style
+from .common import TrialLine, label_axes, plot_series, trial_column
+
+#: Labels of the explorer's artists, so tests and readers can find them.
+TRUTH_LABEL = "true position"
+VISION_LABEL = "noisy vision"
+ESTIMATE_LABEL = "filtered estimate"
+BAND_LABEL = "±2σ of the filter's own variance"
+#: The explorer's lines by gid (:data:`~lqe_helpers.figures.common.TrialLine`).
+_VISION_LINES: dict[str, TrialLine] = {
+    "vision": (0, "vision", VISION_LABEL),
+    "truth": (0, "truth", TRUTH_LABEL),
+    "estimate": (0, "estimate", ESTIMATE_LABEL),
+}
+
+
+class VisionPanel(NamedTuple):
+    """The artists :func:`vision_panel` draws; the explorer refills all but the truth."""
+
+    ax: Axes
+    vision: Line2D
+    band: FillBetweenPolyCollection
+    estimate: Line2D
+
+
+def vision_panel(figure: Figure, times: np.ndarray, truth: np.ndarray,
+                 duration: float) -> VisionPanel:
+    """Notebook 01's explorer on the empty ``figure``: one trial, no data but the truth.
+
+    ``times`` (s) and ``truth`` (true position, cm), shape (n,) each. The vision, band
+    (the filter's ±2σ) and estimate wait for data; the x axis spans 0 to ``duration`` (s).
+    """
+    ax = figure.add_subplot()
+    times = np.asarray(times, dtype=float)
+    empty = np.zeros_like(times)
+    lines = trial_column(ax, None, times, _VISION_LINES,
+                         {"vision": empty, "truth": truth, "estimate": empty},
+                         error_linewidth=1.0, zero_line_first=False)
+    band = ax.fill_between(times, times, times, color=COLORS["estimate"], alpha=0.15,
+                           linewidth=0, label=BAND_LABEL, zorder=DATA_UNDER_LINES)
+    ax.set_xlim(0.0, duration)
+    label_time_position(ax)
+    ax.legend(handles=[lines["vision"], band, lines["truth"], lines["estimate"]],
+              loc="upper center", bbox_to_anchor=(0.5, -0.17), ncol=4, fontsize=9,
+              markerscale=3)
+    figure.subplots_adjust(left=0.08, right=0.98, top=0.97, bottom=0.27)
+    return VisionPanel(ax, lines["vision"], band, lines["estimate"])
 
 
 def estimate_error_figure(times: np.ndarray,

@@ -454,43 +454,7 @@ def test_assumed_noise_figure_zooms_on_the_cost_of_misjudging():
         plt.close(fig)
 
 
-# --- notebook 03's trial figure, and the pieces every figure module shares ---
-
-def test_fusion_trial_figure_draws_readings_truth_and_both_estimates_with_errors():
-    times = np.linspace(0.0, 1.0, 11)
-    truth = 10 * np.sin(times)
-    vision, fused = truth + 0.3, truth - 0.1
-    readings = np.stack([truth + 1.0, truth - 2.0], axis=-1)
-    fig = figures.fusion_trial_figure(times, truth, vision, fused, readings=readings,
-                                      fused_label="vision + noisier proprioception",
-                                      title="σ_p = 4.5 cm")
-    try:
-        top, bottom = fig.axes
-        labels = [line.get_label() for line in top.get_lines()]
-        assert labels == ["vision readings", "proprioception readings", "true position",
-                          "vision only", "vision + noisier proprioception"]
-        for line, expected in zip(top.get_lines(), [*readings.T, truth, vision, fused],
-                                  strict=True):
-            np.testing.assert_array_equal(line.get_ydata(), expected)
-        errors = {line.get_label(): line.get_ydata() for line in bottom.get_lines()}
-        np.testing.assert_allclose(errors["vision only"], vision - truth)
-        np.testing.assert_allclose(errors["vision + noisier proprioception"], fused - truth)
-        assert top.get_title() == "σ_p = 4.5 cm"
-    finally:
-        plt.close(fig)
-    without = figures.fusion_trial_figure(times, truth, vision, fused)
-    try:
-        assert [line.get_label() for line in without.axes[0].get_lines()] == [
-            "true position", "vision only", "vision + proprioception"]
-    finally:
-        plt.close(without)
-
-
-def test_fusion_trial_figure_refuses_readings_of_the_wrong_shape():
-    times = np.linspace(0.0, 1.0, 11)
-    with pytest.raises(ValueError, match=r"readings must have shape \(n, 2\) = \(11, 2\)"):
-        figures.fusion_trial_figure(times, times, times, times, readings=np.zeros((11, 1)))
-
+# --- the pieces every figure module shares ---
 
 def test_label_axes_sets_scales_before_limits_and_draws_the_legend_asked_for():
     from lqe_helpers.figures.common import label_axes

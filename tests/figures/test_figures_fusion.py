@@ -64,13 +64,17 @@ def test_frequency_response_figure_refuses_what_it_cannot_draw(frequency, bad, m
     plt.close("all")
 
 
-def test_fusion_trial_figure_puts_its_legend_above_the_data_under_the_title():
-    """The readings fill the top panel from edge to edge: a legend inside covered them."""
+def test_the_trial_figure_puts_its_legend_above_the_data_under_the_title():
+    """The readings fill the top panel from edge to edge: a legend inside covered them
+    (notebook 03's Figure 1, drawn by tracking_comparison_figure)."""
     times = np.linspace(0.0, 10.0, 1001)
     truth = 10 * np.sin(np.pi * times)
-    readings = np.stack([truth + 3.0, truth - 3.0], axis=-1)
-    fig = figures.fusion_trial_figure(times, truth, truth + 0.5, truth - 0.5,
-                                      readings=readings, title="σ_v = σ_p = 1.5 cm")
+    fig = figures.tracking_comparison_figure(
+        times, truth, {"vision only": (truth + 0.5, "alternative"),
+                       "vision + proprioception": (truth - 0.5, "estimate")},
+        readings={"vision readings": (truth + 3.0, "vision"),
+                  "proprioception readings": (truth - 3.0, "proprioception")},
+        title="σ_v = σ_p = 1.5 cm")
     try:
         fig.canvas.draw()
         top = fig.axes[0]
