@@ -11,7 +11,6 @@ The Going further tasks are checked in :mod:`lqe_helpers.checks.background_furth
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable, Mapping
 
 import numpy as np
@@ -36,6 +35,7 @@ from .machinery import (
     tolerance_text,
 )
 from .own_work import FUNCTION_TASKS
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -151,7 +151,7 @@ def _check_task_A(A: object) -> None:
 _COVARIANCE_CASES = ((3, 1), (2, 1), (4, 2), (1, 1), (3, 2))
 
 
-@functools.cache
+@remembered
 def _covariance_cases() -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray, float], ...]:
     """(P, F, G, σ) for each case, drawn from ``SEED + 2`` (read-only arrays)."""
     rng = np.random.default_rng(SEED + 2)
@@ -262,7 +262,7 @@ EYES_CLOSE_TIME = 2.0
 EYES_CLOSED_STEPS = 100
 
 
-@functools.cache
+@remembered
 def _eyes_closed() -> dict[str, object]:
     """Task 2's right band (101,) (cm) and crossing (s), and the likely wrong bands."""
     result = experiments.track(DEFAULT).result

@@ -13,7 +13,6 @@ Tasks C and E, about choosing σ_j, are checked in
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Mapping
 
 import numpy as np
@@ -32,6 +31,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -217,7 +217,7 @@ def white_jerk_q(jerk_std: float, dt: float, sub_steps: int) -> np.ndarray:
     return jerk_std**2 * sub_steps * moved.T @ moved
 
 
-@functools.cache
+@remembered
 def _white() -> dict[str, object]:
     """Task D's Q_white and the paired % interval, recomputed, with wrong variants."""
     sigma_j, dt, M = _sigma_j(), DEFAULT.dt, SUB_STEPS

@@ -10,7 +10,6 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Mapping
 
 import numpy as np
@@ -27,6 +26,7 @@ from .machinery import (
     shaped_argument,
     tolerance_text,
 )
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -46,7 +46,7 @@ def choice_grid() -> np.ndarray:
 # C · too small or too large
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _sweep() -> dict[str, np.ndarray]:
     """Task C's sweep recomputed (read-only arrays), with the usual wrong variants."""
     grid = jerk_grid()
@@ -197,7 +197,7 @@ def check_jerk_sweep_reading(near: object, crossing_jerk: object) -> None:
 CHOICE_KEYS = ("likelihood", "NIS", "MSE")
 
 
-@functools.cache
+@remembered
 def _choice() -> dict[str, object]:
     """Task E recomputed: the NIS at the derived σ_j (and wrong variants), and the choice.
 

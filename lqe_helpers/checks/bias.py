@@ -10,8 +10,6 @@ The Going further tasks are checked in :mod:`lqe_helpers.checks.bias_further`.
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import bias_model, experiments, metrics
@@ -28,6 +26,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -130,7 +129,7 @@ def check_bias_model(F: np.ndarray, G: np.ndarray, Q: np.ndarray, dt: float,
            f"σ_a = {sigma_a:g} cm/s², to {tolerance_text(MATRIX_RTOL)}")
 
 
-@functools.cache
+@remembered
 def _signal_worth() -> dict[str, object]:
     """Task 2's paired interval vision only − with the signal (cm²), with the usual wrong ones."""
     truth = DEFAULT.truth[:, 0]

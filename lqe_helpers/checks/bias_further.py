@@ -14,7 +14,6 @@ as the notebook's tasks make them.
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -34,6 +33,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -42,14 +42,14 @@ __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's 
 BIAS, SIGMA_A = bias_model.DEFAULT_BIAS, bias_model.DEFAULT_SIGMA_A
 
 
-@functools.cache
+@remembered
 def _monte_carlo() -> bias_model.InputTracking:
     """The notebook's ``mc``: the default runs with the signal."""
     return bias_model.track_with_input(DEFAULT, bias=BIAS, sigma_a=SIGMA_A,
                                        runs=DEFAULT.mc_runs, noise=_noise())
 
 
-@functools.cache
+@remembered
 def _vision_only() -> np.ndarray:
     """Per-run MSEs (runs,) of the vision-only filter on the same camera noise (cm²)."""
     return vision_runs().mse()  # bias_model.unit_noise's column 0 is vision's draw
@@ -215,7 +215,7 @@ def sigma_a_grid() -> np.ndarray:
 SWEEP_CHECKED = (0, 3, 6, 9, 12)
 
 
-@functools.cache
+@remembered
 def _noise() -> np.ndarray:
     """The notebook's draw of ``[vision, acceleration]`` noise for its Monte Carlo runs."""
     noise = bias_model.unit_noise(DEFAULT, DEFAULT.mc_runs)
@@ -223,7 +223,7 @@ def _noise() -> np.ndarray:
     return noise
 
 
-@functools.cache
+@remembered
 def _sweep() -> dict[str, object]:
     """Task C's σ_a sweep recomputed at :data:`SWEEP_CHECKED`, with the usual wrong variants."""
     vision = _vision_only()
@@ -310,7 +310,7 @@ OTHER_BIASES = (-60.0, 0.0, 60.0)
 SIGMAS_V = (0.5, 1.5, 4.5)
 
 
-@functools.cache
+@remembered
 def _bias_and_vision() -> dict[str, dict]:
     """Task C's changes by bias (intervals, %) and by σ_v (%), with wrong variants."""
     unbiased = bias_model.unbiased_run(DEFAULT, SIGMA_A, runs=DEFAULT.mc_runs, noise=_noise())

@@ -8,13 +8,13 @@ from the engine's delay, so no readable worked ``compensate`` lives here.
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..simulation import delay_signal
 from .machinery import SEED
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -38,7 +38,7 @@ class Case:
                 f"{self.A.shape} and delay_steps = {self.delay}")
 
 
-@functools.cache
+@remembered
 def cases() -> tuple[Case, ...]:
     """The random cases of :func:`check_compensation`, from the fixed seed."""
     rng = np.random.default_rng(SEED + 1)

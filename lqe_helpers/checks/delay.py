@@ -15,7 +15,6 @@ tasks are checked in :mod:`lqe_helpers.checks.delay_sweep` and
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -44,6 +43,7 @@ from .machinery import (
 )
 from .own_work import FUNCTION_TASKS
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -198,7 +198,7 @@ def _check_zero_delay(compensate: Callable, name: str, case: Case) -> None:
 _SIGNALS = ("late_readings", "delayed", "compensated")
 
 
-@functools.cache
+@remembered
 def _trial() -> dict[str, object]:
     """Task 2 recomputed: the three signals (n,) (cm) and each one's likely mistakes."""
     tracking = experiments.track(DEFAULT)
@@ -351,7 +351,7 @@ def check_delay_signals(late_readings: np.ndarray, delayed: np.ndarray,
 # Task 3: many runs, paired
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def monte_carlo_mses() -> dict[str, np.ndarray]:
     """Per-run MSEs (runs,) (cm²) at the question's delay: delayed, compensated, undelayed."""
     tracking = vision_runs()

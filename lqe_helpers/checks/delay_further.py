@@ -11,8 +11,6 @@ pack's engine) before looking at the student's values:
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import experiments, metrics
@@ -23,6 +21,7 @@ from .delay_sweep import prediction_theory, sweep
 from .judging import judge, judge_interval, mse_mistakes
 from .machinery import INTERVAL_RTOL, MSE_RTOL, passed, tolerance_text
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -43,7 +42,7 @@ def _mse(x: np.ndarray, start: int = _SKIP) -> float | None:
 # Part 1: a perfect but late eye
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _late_eye() -> dict[str, object]:
     """Part 1 recomputed, with each value's likely mistakes."""
     times, frequency = DEFAULT.times, DEFAULT.frequency
@@ -137,7 +136,7 @@ def check_late_eye(mse_late_eye: float, lead: float, mse_clean_delayed: float,
 # Part 3: the shortest delays
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _short() -> dict[str, object]:
     """Part 3 recomputed, with each value's likely mistakes."""
     v = DEFAULT.truth[:, 1]

@@ -16,8 +16,6 @@ the filter's model) before looking at the student's values:
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import experiments, metrics
@@ -26,6 +24,7 @@ from ..scenario import DEFAULT
 from ..simulation import delay_signal
 from .judging import judge
 from .machinery import MATRIX_RTOL, MSE_RTOL, CheckFailed, argument_array, passed, tolerance_text
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -40,7 +39,7 @@ _BURN = DEFAULT.burn_in_steps
 _STEPS = DEFAULT.delay_steps(DEFAULT.delay)
 
 
-@functools.cache
+@remembered
 def sweep() -> dict[str, np.ndarray]:
     """Per-run MSEs (cm²), shape (SWEEP_STEPS + 1, runs), of both estimates at each delay.
 
@@ -135,7 +134,7 @@ def check_delay_sweep(delays: np.ndarray, sweep_mse: dict[str, np.ndarray]) -> N
            f"{tolerance_text(MSE_RTOL)} relative")
 
 
-@functools.cache
+@remembered
 def prediction_theory() -> dict[str, np.ndarray]:
     """Part 2's theory (cm²), shape (301,) over 0–3 s, and the covariances it starts from.
 
@@ -286,7 +285,7 @@ def check_compensation_regimes(help_from: float, help_to: float, best_delay: flo
            f"Task 3's runs to {tolerance_text(MSE_RTOL)} relative")
 
 
-@functools.cache
+@remembered
 def _sources() -> dict[str, tuple[float, dict[str, float | None]]]:
     """Where the jerks take over (s) and both log–log slopes, with their likely mistakes."""
     t = prediction_theory()

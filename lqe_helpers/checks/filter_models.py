@@ -8,7 +8,6 @@ or from the engine's gains with a changed update, so no readable worked filter l
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -16,6 +15,7 @@ import numpy as np
 from .. import model
 from ..filter import FILTER_ARGS, kalman_filter
 from .machinery import SEED
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -73,7 +73,7 @@ FILTER_SIZES = ((3, 1), (2, 2), (1, 1), (4, 3), (3, 2), (2, 1))
 FILTER_STEPS = 15
 
 
-@functools.cache
+@remembered
 def models() -> tuple[FilterCase, ...]:
     """The models of :func:`check_filter`, drawn once from :data:`SEED` (read-only)."""
     rng = np.random.default_rng(SEED)
@@ -103,7 +103,7 @@ def models() -> tuple[FilterCase, ...]:
     return tuple(drawn)
 
 
-@functools.cache
+@remembered
 def right_estimates(index: int) -> np.ndarray:
     """The engine's estimates (n, k) on model ``index`` (read-only)."""
     estimates = np.array(models()[index].engine().estimates)
@@ -141,7 +141,7 @@ def _estimates_with(m: FilterCase, gains, start: str, compare: str) -> np.ndarra
     return np.array(rows)
 
 
-@functools.cache
+@remembered
 def mistaken_estimates(mistake: str, index: int) -> np.ndarray | None:
     """Eq. (5) on model ``index`` with one of :data:`FILTER_MISTAKES`; None if it cannot run."""
     m = models()[index]

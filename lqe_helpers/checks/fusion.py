@@ -39,6 +39,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .remembering import remembered
 from .shared_runs import vision_runs
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -232,7 +233,7 @@ def setup_slips(y: np.ndarray, sigmas: list[float]) -> dict[str, np.ndarray]:
     }
 
 
-@functools.cache
+@remembered
 def _trial() -> dict[str, object]:
     """Task 2's right positions (n,) and MSEs (cm²), and the likely mistakes of each."""
     tracking = experiments.track(DEFAULT, FUSED)
@@ -360,7 +361,7 @@ def check_fusion_trial(vision_positions: np.ndarray, fused_positions: np.ndarray
 # Task 3: many trials, compared pair by pair
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def monte_carlo_mses() -> dict[str, np.ndarray]:
     """Task 3's runs: positions (runs, n) (cm) and per-run MSEs (runs,) (cm²), read-only.
 

@@ -18,7 +18,6 @@ answer from the recomputation (:data:`THEORY_RTOL`).
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Mapping
 
 import numpy as np
@@ -29,6 +28,7 @@ from ..steady_state import steady_state
 from .fusion import FUSED, engine_positions, monte_carlo_mses
 from .judging import judge
 from .machinery import CheckFailed, argument_array, passed, tolerance_text
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -62,7 +62,7 @@ def _position_variance(sensors: tuple[str, ...], sigmas: np.ndarray | None = Non
 # Part 1: the systematic error, without noise
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _fits() -> dict[str, dict[str, metrics.SinusoidFit]]:
     """The right fit of each filter and the fits its likely mistakes give."""
     times, truth = DEFAULT.times, DEFAULT.truth[:, 0]

@@ -17,8 +17,6 @@ the Going further tasks are in :mod:`lqe_helpers.checks.initial_covariance_furth
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import experiments, metrics
@@ -44,6 +42,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -60,13 +59,13 @@ _SMALL_LARGE = ("small", "large")
 # The engine's runs of the task's draw, computed once
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def question_runs() -> experiments.Tracking:
     """``DEFAULT.mc_runs`` runs from both P0 of the question (axis 1), on the task's draws."""
     return experiments.track(DEFAULT, p0_variance=list(QUESTION_P0), runs=DEFAULT.mc_runs)
 
 
-@functools.cache
+@remembered
 def squared_errors() -> np.ndarray:
     """Squared position errors (cm²) of :func:`question_runs`, shape (runs, 2, n), read-only."""
     values = (question_runs().positions - DEFAULT.truth[:, 0]) ** 2
@@ -181,7 +180,7 @@ def _trial_estimates(p0_variance: float, *, z0: np.ndarray | None = None,
                                    vision.P0).filter(y).estimates
 
 
-@functools.cache
+@remembered
 def _trial() -> dict[str, np.ndarray]:
     """The right estimates of Task 1 and the likely mistakes, each (n, 3)."""
     right = {name: _trial_estimates(p0) for name, p0 in zip(_SMALL_LARGE, QUESTION_P0,
@@ -280,7 +279,7 @@ def squared_against_readings(trial: bool = False) -> np.ndarray:
     return (runs.positions - (readings[0] if trial else readings)) ** 2
 
 
-@functools.cache
+@remembered
 def _convergence() -> dict[str, object]:
     """The right convergence times of Task 2 (s) and their likely mistakes, by P0."""
     squared, dt = squared_errors(), DEFAULT.dt
@@ -380,7 +379,7 @@ def check_convergence_times(t_small: float, t_large: float) -> None:
 # Task 3: the start-up and the settled filter, paired
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def window_mses() -> dict[str, np.ndarray]:
     """Per-run position MSEs (cm²), shape (runs, 2), over the windows of Task 3 and its slips.
 

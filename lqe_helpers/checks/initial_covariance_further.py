@@ -16,8 +16,6 @@ The core path's checks, and the engine's runs these share with them, are in
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import experiments, metrics
@@ -40,6 +38,7 @@ from .machinery import (
     passed,
     tolerance_text,
 )
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -128,7 +127,7 @@ def _engine_gains(P0: np.ndarray, *, A: np.ndarray | None = None, Q: np.ndarray 
         model.R if R is None else R, model.z0, P0).filter(np.zeros((2, 1))).gains[:, :, 0]
 
 
-@functools.cache
+@remembered
 def _gains() -> dict[str, object]:
     """The engine's K₁ and K₂ from both P0, shape (2 P0, 2 gains, 3), and the mistakes."""
     right = question_runs().result.gains[0, :, :2, :, 0]
@@ -198,7 +197,7 @@ def check_first_gains(gains_small: np.ndarray, gains_large: np.ndarray) -> None:
 # 3. Overconfidence: the actual error over the filter's own variance
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _overconfidence() -> dict[str, np.ndarray]:
     """The right ratio (2, burn) and the ratios of the likely mistakes."""
     burn = DEFAULT.burn_in_steps
@@ -267,7 +266,7 @@ def check_overconfidence(overconfidence: np.ndarray) -> None:
 # 4. Bootstrap intervals on the convergence times
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _intervals() -> dict[str, object]:
     """The right intervals (a generator seeded with DEFAULT.seed, used for both in turn)."""
     squared, dt = squared_errors(), DEFAULT.dt
@@ -363,7 +362,7 @@ def check_convergence_intervals(convergence_small: metrics.Interval,
 # 5. The sweep over P0
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _sweep() -> dict[str, object]:
     """MSEs (runs, 5) and convergence times (5,) at :data:`SWEEP_CHECKED`, and the mistakes."""
     sweep = experiments.track(DEFAULT, p0_variance=P0_GRID[list(SWEEP_CHECKED)],

@@ -12,8 +12,6 @@ the Monte Carlo runs of :mod:`lqe_helpers.checks.noisier_proprioception`.
 
 from __future__ import annotations
 
-import functools
-
 import numpy as np
 
 from .. import experiments, metrics
@@ -31,6 +29,7 @@ from .noisier_proprioception import (
     sigma_grid,
 )
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -94,7 +93,7 @@ def check_misjudged(excess: dict) -> None:
            f"matches the pack's engine to {tolerance_text(INTERVAL_RTOL)} relative")
 
 
-@functools.cache
+@remembered
 def _nis(assumed: float) -> dict[str, float]:
     """The NIS of the fused filter assuming σ̃_p = ``assumed`` (true 4.5 cm), and mistakes."""
     tracking = experiments.track(DEFAULT, FUSED, sigmas=[SIGMA_V, SIGMA_P],

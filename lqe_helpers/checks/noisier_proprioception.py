@@ -17,7 +17,6 @@ before it looks at the student's value, and names the likely cause of a wrong on
 
 from __future__ import annotations
 
-import functools
 from functools import partial
 
 import numpy as np
@@ -46,6 +45,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -63,7 +63,7 @@ TRUTH = DEFAULT.truth[:, 0]
 BURN = DEFAULT.burn_in_steps
 
 
-@functools.cache
+@remembered
 def monte_carlo(sigmas: tuple[float, ...],
                 assumed: tuple[float, ...] | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Per-run MSEs (runs,) (cm²) after the burn-in and over the whole trial, read-only.
@@ -153,7 +153,7 @@ def check_noisier_sense(sigma_p: float, R: np.ndarray) -> None:
 # Task 2: one trial, filtered both ways
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _trial() -> dict[str, dict]:
     """Task 2's right positions (n,) (cm) and MSEs (cm²) of each filter, with the likely
     mistakes of each."""

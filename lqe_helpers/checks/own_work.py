@@ -174,15 +174,23 @@ class Forbidden:
     cell: task_runs.TaskRun  # the cell: the task cell or one of the student's it drew on
 
 
+#: The checks' own code: it computes every task's answer, so a cell may run it only through
+#: a check (:data:`A_CHECK`), which gives no answer away.
+CHECKS = "lqe_helpers.checks."
+A_CHECK = "lqe_helpers.checks.own_work.judged."
+
+
 def forbidden_calls(check: str, run: task_runs.TaskRun) -> list[Forbidden]:
-    """The functions of ``check``'s forbidden set run by the task run ``run`` or by a cell of
-    the student's whose values it drew on (:func:`~lqe_helpers.student_code.task_runs.ancestry`),
-    the task cell's first, each cell's in the order it first ran them."""
-    entries = TOP_LEVEL.get(check, ())
+    """The functions of ``check``'s forbidden set (and of the checks' own code, but through a
+    check) run by the task run ``run`` or by a cell of the student's whose values it drew on
+    (:func:`~lqe_helpers.student_code.task_runs.ancestry`), the task cell's first, each
+    cell's in the order it first ran them."""
+    entries = (*TOP_LEVEL.get(check, ()), CHECKS)
     return [Forbidden(name, cell.entries.get(name, name), cell)
             for cell in task_runs.ancestry(run)
             for name in dict.fromkeys(cell.pack_calls.values())
-            if any(covers(entry, name) for entry in entries)]
+            if not cell.entries.get(name, name).startswith(A_CHECK)
+            and any(covers(entry, name) for entry in entries)]
 
 
 def _short(name: str) -> str:
@@ -233,8 +241,6 @@ def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
     used = forbidden_calls(check, run)
     if used:
         return forbidden_text(used[0], run)
-    if check not in TOP_LEVEL:
-        return None
     for cell in task_runs.ancestry(run):
         if cell.outside:
             where = ("the task cell above" if cell.number == run.number else
@@ -355,8 +361,9 @@ def copied_result(check: str, args: tuple, run: task_runs.TaskRun) -> str | None
     if check in DRIVEN or not entries:
         return None
     given = task_runs.argument_names(task_runs.current_cell(), check)
-    earlier = [(cell, name, result) for cell, name, result in task_runs.earlier_results(run)
+    earlier = [(cell, name, result) for cell, name, result in task_runs.earlier_results(run, check)
                if any(covers(entry, name) for entry in entries)
+               and not cell.entries.get(name, name).startswith(A_CHECK)
                and (not cell.defines & set(given) or _HIDDEN_CHANNEL.search(cell.source))]
     for position, value in enumerate(args):
         for leaf in _leaves(value):
@@ -393,6 +400,7 @@ def judged(check: Callable) -> Callable:
         problem = provenance_problem(name, args, run) or copied_result(name, args, run)
         if problem is not None:
             raise CheckFailed(problem)
+        run.passed.add(name)
         print(said.getvalue(), end="")
         return result
 

@@ -9,17 +9,17 @@ check reads them there instead of keeping a copy of its own.
 from __future__ import annotations
 
 import dataclasses
-import functools
 
 import numpy as np
 
 from .. import experiments
 from ..scenario import DEFAULT
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
 
-@functools.cache
+@remembered
 def vision_runs() -> experiments.Tracking:
     """``experiments.track(DEFAULT, runs=DEFAULT.mc_runs)``, with every array read-only.
 

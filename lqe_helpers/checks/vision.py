@@ -14,7 +14,6 @@ keyed by σ_v or Δt) serve the Going further checks (:mod:`~lqe_helpers.checks.
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -39,6 +38,7 @@ from .machinery import (
     tolerance_text,
 )
 from .own_work import FUNCTION_TASKS, not_driven, outputs_of
+from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
 
@@ -235,7 +235,7 @@ def _estimates(readings: np.ndarray, r_variance: float) -> np.ndarray:
     return dataclasses.replace(vision, R=np.array([[r_variance]])).filter(readings).estimates
 
 
-@functools.cache
+@remembered
 def _trial(sigma_v: float) -> dict[str, object]:
     """Task 2's readings (n, 1) and estimates (n, 3) at ``sigma_v``, and the likely mistakes."""
     other = SIGMAS_V[1] if sigma_v == SIGMAS_V[0] else SIGMAS_V[0]
@@ -347,7 +347,7 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
 # The core path's Monte Carlo runs (the notebook's given batch)
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def monte_carlo() -> experiments.Tracking:
     """The core path's runs: ``DEFAULT.mc_runs`` runs at σ_v = 1.5 and 4.5 cm, shape (runs, 2, ...).
 

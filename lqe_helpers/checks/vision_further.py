@@ -16,7 +16,6 @@ student's values.
 from __future__ import annotations
 
 import dataclasses
-import functools
 from collections.abc import Callable
 
 import numpy as np
@@ -26,6 +25,7 @@ from ..scenario import DEFAULT
 from ..steady_state import SteadyState
 from .judging import judge, mse_mistakes
 from .machinery import MSE_RTOL, CheckFailed, passed, tolerance_text
+from .remembering import remembered
 from .vision import SIGMAS_V, keyed, monte_carlo
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -59,7 +59,7 @@ def _judge_each_sigma(values: dict[str, dict[float, object]], units: dict[str, s
 # Part 2: the systematic error
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _noise_free(column: int) -> np.ndarray:
     """Positions (n,) (cm) of the filter fed noise-free readings at σ_v = SIGMAS_V[column]."""
     positions = experiments.track(DEFAULT, sigmas=[SIGMAS_V[column]],
@@ -72,7 +72,7 @@ def _fit(positions: np.ndarray, start: int) -> metrics.SinusoidFit:
     return metrics.fit_sinusoid(DEFAULT.times[start:], positions[..., start:], DEFAULT.frequency)
 
 
-@functools.cache
+@remembered
 def _split(column: int) -> dict[str, dict[str, object]]:
     """Right values of part 2 at one σ_v and their likely mistakes, by the student's name."""
     burn = DEFAULT.burn_in_steps
@@ -165,7 +165,7 @@ def _coverage(errors: np.ndarray, limits: np.ndarray) -> float:
     return 100.0 * float(np.mean(np.abs(errors) <= limits))
 
 
-@functools.cache
+@remembered
 def _confidence(column: int) -> dict[str, dict[str, object]]:
     """Right forecast and coverage at one σ_v and their likely mistakes."""
     sigma, burn = SIGMAS_V[column], DEFAULT.burn_in_steps
@@ -228,7 +228,7 @@ def check_steady_state(forecast: dict[float, float], coverage: dict[float, float
            f"{tolerance_text(MSE_RTOL)} relative")
 
 
-@functools.cache
+@remembered
 def _nis(column: int) -> dict[str, dict[str, object]]:
     """Right mean NIS and share of runs in the band at one σ_v, and likely mistakes."""
     burn, n = DEFAULT.burn_in_steps, DEFAULT.n_steps
@@ -306,7 +306,7 @@ def check_nis(nis_mean: dict[float, float], runs_inside: dict[float, float]) -> 
 # Part 4: the sampling rate
 # ------------------------------------------------------------------------------------------
 
-@functools.cache
+@remembered
 def _sampling_mses(dt: float, jerk_std: float | None = None) -> dict[str, np.ndarray]:
     """Per-run MSEs (runs,) (cm²) of part 4's raw readings and estimates at Δt = ``dt``.
 

@@ -11,7 +11,6 @@
 
 from __future__ import annotations
 
-import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -39,6 +38,7 @@ from .machinery import (
 )
 from .own_work import FUNCTION_TASKS
 from .paired_mistakes import interval_mistakes
+from .remembering import remembered
 from .vision import SIGMAS_V, keyed, monte_carlo
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -77,7 +77,7 @@ class SmootherCase:
         return (self.y, float(self.alpha) if self.alpha.ndim == 0 else self.alpha)
 
 
-@functools.cache
+@remembered
 def smoother_cases() -> tuple[SmootherCase, ...]:
     """The cases of :func:`check_smoother`, drawn once from :data:`SEED` (read-only).
 
@@ -103,13 +103,13 @@ def smoother_cases() -> tuple[SmootherCase, ...]:
     return tuple(made)
 
 
-@functools.cache
+@remembered
 def _right(index: int) -> np.ndarray:
     case = smoother_cases()[index]
     return smoothing.exponential_smoother(case.y, case.alpha)
 
 
-@functools.cache
+@remembered
 def _mistaken(mistake: str, index: int) -> np.ndarray | None:
     """The smoother of case ``index`` with one of :data:`SMOOTHER_MISTAKES`."""
     case = smoother_cases()[index]
@@ -256,7 +256,7 @@ def _grid(alphas: object) -> np.ndarray:
     return grid
 
 
-@functools.lru_cache(maxsize=4)
+@remembered
 def _tuned(column: int, grid: tuple[float, ...], burn_in_steps: int) -> smoothing.TunedSmoother:
     """The pack's tuned smoother on the core path's readings at σ_v = SIGMAS_V[column].
 

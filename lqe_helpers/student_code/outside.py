@@ -15,7 +15,8 @@ through which the pack sees which functions run (``sys.setprofile``; Python anno
 when it drops a hook that raised, which the pack's hooks say first: :func:`dropping`),
 starting a thread
 (whose calls no hook of this thread sees), or making a function from another's code by hand
-(``code.replace``, ``types.FunctionType``: a pack function under another file's name).
+(``code.replace``, ``types.FunctionType``, ``marshal``, ``__code__``: a pack function under
+another file's name), or C code through ``ctypes`` (a thread of its own, say).
 
 Files of the installation are not news: Python's and its packages' (``sys.prefix``, the
 site folders), the pack's modules, the system's folders, matplotlib's and IPython's settings
@@ -47,8 +48,24 @@ OTHER_SOURCES = {"sqlite3.connect": "opens the database {0}",
 #: The audit events of the student's own code changing what the pack's watch sees.
 TAMPERING = {"sys.setprofile": "switches off the pack's watch of the functions it runs "
                                "(sys.setprofile)",
+             "ctypes.dlopen": "uses C code through ctypes, whose calls the pack cannot watch",
+             "ctypes.dlsym": "uses C code through ctypes, whose calls the pack cannot watch",
+             "marshal.loads": "loads code with marshal",
+             "object.__setattr__": "replaces a function's code (__code__)",
+             "sys._getframe": "looks into the frames of the code that runs (sys._getframe)",
+             "object.__getattr__": "looks into the frames of a traceback or a generator",
+             "gc.get_objects": "searches the memory for objects (gc.get_objects)",
+             "gc.get_referrers": "searches the memory for objects (gc.get_referrers)",
+             "gc.get_referents": "searches the memory for objects (gc.get_referents)",
              "code.__new__": "makes a code object by hand (code.replace, types.CodeType)",
              "function.__new__": "makes a function by hand (types.FunctionType)"}
+#: Of the attribute events, the attributes that are news.
+WATCHED_ATTRIBUTES = {"object.__setattr__": ("__code__",),
+                      "object.__getattr__": ("tb_frame", "gi_frame", "cr_frame", "ag_frame")}
+#: Modules whose frames ask on the student's behalf: the event's caller is the one above.
+_ASKED_FOR = {"ctypes.dlopen": f"{os.sep}ctypes{os.sep}__init__.py",
+              "ctypes.dlsym": f"{os.sep}ctypes{os.sep}__init__.py",
+              "sys._getframe": f"{os.sep}inspect.py"}
 #: The C functions that start or become another program (os.system, fork, exec, spawn).
 PROCESS_CALLS = frozenset(getattr(os, name) for name in (
     "system", "fork", "forkpty", "execv", "execve", "execvp", "execvpe", "execl", "execle",
@@ -72,6 +89,7 @@ _PACK_FOLDER = os.path.realpath(Path(__file__).resolve().parent.parent)
 _listeners: dict[int, list[Callable[[str], None]]] = {}
 _dropping: set[int] = set()  # the threads whose profile hook of the pack is raising
 _time_up: set[int] = set()   # the threads whose call a time limit is stopping
+_hearing: set[int] = set()   # the threads whose audit hook is asking who caused an event
 _hooked: list[bool] = []  # [True] once the audit hook is added (changed in place, so that a
                           # check's snapshot of the pack's globals sees no change)
 
@@ -136,13 +154,35 @@ def _heard(event: str, args: tuple) -> None:
     stack = _listeners.get(threading.get_ident())
     if not stack:
         return
-    if event in TAMPERING:  # news only from the student's own code, not a library's
-        caller = sys._getframe(1).f_code.co_filename
-        what = "" if installation_file(caller) else TAMPERING[event]
+    if event in TAMPERING:
+        thread = threading.get_ident()
+        if thread in _hearing:  # the sys._getframe of tampering() itself
+            return
+        _hearing.add(thread)
+        try:
+            what = tampering(event, args)
+        finally:
+            _hearing.discard(thread)
     else:
         what = use_of_outside(event, args)
     if what:
         stack[-1](what)
+
+
+def tampering(event: str, args: tuple) -> str:
+    """What the :data:`TAMPERING` event ``event`` says, if the student's own code (not a
+    library's, not the pack's) caused it, or "". Called by the audit hook."""
+    if event.startswith("object.") and (len(args) < 2 or args[1] not in WATCHED_ATTRIBUTES[
+            event]):
+        return ""
+    frame = sys._getframe(2)  # the hook's caller
+    asked_for = _ASKED_FOR.get(event)
+    while asked_for and frame.f_back is not None and frame.f_code.co_filename.endswith(
+            asked_for):
+        frame = frame.f_back  # who asked ctypes or inspect: their own frames say nothing
+    caller = frame.f_code.co_filename
+    library = caller.startswith("<frozen ") or installation_file(caller)  # importlib's
+    return "" if library else TAMPERING[event]
 
 
 def use_of_outside(event: str, args: tuple) -> str:
@@ -228,4 +268,4 @@ def _shown(path: str) -> str:
 #: What runs inside a student's function when it uses the outside: the audit hook and what
 #: it asks (``calling`` lets a watched function run them, as machinery).
 HEARING = (_heard, use_of_outside, installation_file, _installation_folders.__wrapped__,
-           _shown, c_call_use, dropping, time_is_up)
+           _shown, c_call_use, dropping, time_is_up, tampering)

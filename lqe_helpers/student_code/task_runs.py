@@ -114,6 +114,8 @@ class TaskRun:
         :data:`OUTSIDE_KEPT`.
     saved_calls : list of SavedCall
         Its calls of the student's loaded functions.
+    passed : set of str
+        The checks that passed on its values (their functions' names).
     """
 
     number: int
@@ -130,6 +132,7 @@ class TaskRun:
     results: list[tuple[str, np.ndarray]] = field(default_factory=list)
     outside: list[str] = field(default_factory=list)
     saved_calls: list[SavedCall] = field(default_factory=list)
+    passed: set[str] = field(default_factory=set)
 
     @property
     def first_line(self) -> str:
@@ -302,11 +305,14 @@ def _small_result(value: object) -> np.ndarray | None:
     return np.array(value, dtype=float)
 
 
-def earlier_results(run: TaskRun) -> list[tuple[TaskRun, str, np.ndarray]]:
+def earlier_results(run: TaskRun, check: str) -> list[tuple[TaskRun, str, np.ndarray]]:
     """The results kept (:attr:`TaskRun.results`) by the cells of the student's run before
-    ``run``: (cell, function, result)."""
+    ``run`` and before the first run on which ``check`` passed (a cell after it compares
+    what the student had already done): (cell, function, result)."""
+    passed = [earlier.number for earlier in _RECORD.runs if check in earlier.passed]
+    before = min([run.number, *passed])
     return [(earlier, name, result) for earlier in _RECORD.runs
-            if earlier.number < run.number for name, result in earlier.results]
+            if earlier.number < before for name, result in earlier.results]
 
 
 def ancestry(run: TaskRun) -> list[TaskRun]:

@@ -236,6 +236,7 @@ MACHINERY = {
     "lqe_helpers.student_code.outside._shown",
     "lqe_helpers.student_code.outside.c_call_use",
     "lqe_helpers.student_code.outside.dropping",
+    "lqe_helpers.student_code.outside.tampering",
     "lqe_helpers.student_code.outside.time_is_up",
     "lqe_helpers.student_code.running._Stopper.time_is_up",
     "lqe_helpers.student_code.calling._watch_kept",
@@ -265,7 +266,8 @@ def test_every_function_of_the_pack_a_task_cell_runs_is_refused_by_each_task_for
                 ("lqe_helpers.student_code.task_runs.", "lqe_helpers.student_code.outside.")), name
             for check in own_work.TOP_LEVEL:
                 problem = own_work.task_problem(check, (), run)
-                covered = any(own_work.covers(entry, name) for entry in own_work.TOP_LEVEL[check])
+                covered = any(own_work.covers(entry, name)
+                              for entry in (*own_work.TOP_LEVEL[check], own_work.CHECKS))
                 if covered:
                     assert problem is not None and "runs the pack's" in problem, (check, name)
                     refused[check].add(name)

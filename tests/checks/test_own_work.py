@@ -903,3 +903,63 @@ def test_a_task_cell_that_loses_the_records_hook_is_refused(folder):
             "the task cell above switched off the pack's watch of the functions it runs")
     finally:
         runner.close()
+
+
+#: The sixth trial's routes to the answer a check computes: its frames (a failed check's
+#: traceback), its private helpers, the memory. Each passed with ✓ before.
+CHECKS_ANSWER = {
+    "a failed check's traceback": (
+        "import sys\ntry:\n    checks.check_convergence_times(0.0, 0.0)\n"
+        "except Exception as error:\n    tb = error.__traceback__\n"
+        "while tb.tb_frame.f_code.co_name != 'check_convergence_times':\n"
+        "    tb = tb.tb_next\n"
+        "t_small, t_large = map(float, tb.tb_frame.f_locals['right']['right'])\n",
+        "the task cell above looks into the frames of a traceback or a generator"),
+    "a check's private helper": (
+        "from lqe_helpers.checks import initial_covariance\n"
+        "t_small, t_large = map(float, initial_covariance._convergence()['right'])\n",
+        "the task cell above runs the pack's own checks.initial_covariance._convergence"),
+    "the memory": (
+        "import gc\nfound = [o for o in gc.get_objects() if isinstance(o, dict) and 'right' in o"
+        " and 'runs' in o]\nt_small, t_large = map(float, found[0]['right'])\n",
+        "the task cell above searches the memory for objects"),
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("route", list(CHECKS_ANSWER))
+def test_the_answer_a_check_computes_is_not_the_students(route, folder):
+    code, said = CHECKS_ANSWER[route]
+    error, printed = run_task("02_initial_covariance", "check_convergence_times", code)
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert str(error).startswith(said), error
+
+
+@pytest.mark.slow
+def test_a_task_cell_that_runs_its_own_check_is_not_refused(folder):
+    """The sixth trial: a right task cell that calls its check (✓ there) was then refused by
+    the check cell, which took the check's own run of the pack for the student's."""
+    _before, task, check = cells_up_to("00_background_model", "check_transition_matrix")
+    error, printed = run_task("00_background_model", "check_transition_matrix",
+                              task + "\n" + check + "\n", comment=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+@pytest.mark.slow
+def test_comparing_with_the_pack_after_a_passed_check_then_running_the_task_again_passes(
+        folder):
+    """The sixth trial: the messages suggest comparing with the pack in a new cell below the
+    check; re-running the task cell after that comparison was refused as copied."""
+    before, task, check = cells_up_to("03_fusion", "check_fusion")
+    runner = CellRunner()
+    try:
+        with contextlib.redirect_stdout(io.StringIO()):
+            for source in (*before, task, check,
+                           "from lqe_helpers import model\n"
+                           "same = np.allclose(C, model.observation_matrix(FUSED))\n", task):
+                assert runner.run(source) is None, source[:80]
+        with contextlib.redirect_stdout(io.StringIO()) as printed:
+            error = runner.run(check)
+        assert error is None and printed.getvalue().startswith("✓ "), (error, printed.getvalue())
+    finally:
+        runner.close()

@@ -125,12 +125,15 @@ def test_a_file_opened_to_be_written_afresh_is_not_read(tmp_path, heard):
 
 @pytest.mark.filterwarnings("ignore::pytest.PytestUnraisableExceptionWarning")
 @pytest.mark.parametrize("how", ["sys.setprofile", "C's PyEval_SetProfile", "a thread",
-                                 "code.replace"])
+                                 "code.replace", "ctypes", "marshal", "sys._getframe",
+                                 "a traceback's frame", "the memory"])
 def test_a_function_task_that_leaves_the_watch_is_refused(how):
     """A function task's answer computed by the pack out of the watch's sight: with the
     profile hook off (switched off, or lost through C), in another thread, or by a copy of
     the pack's function under another file's name. Each passed before."""
     import ctypes
+    import gc
+    import marshal
     import types
 
     from lqe_helpers import model
@@ -141,6 +144,20 @@ def test_a_function_task_that_leaves_the_watch_is_refused(how):
             sys.setprofile(None)
         elif how == "C's PyEval_SetProfile":
             ctypes.pythonapi.PyEval_SetProfile(None, None)
+        if how == "ctypes":
+            ctypes.CDLL(None).getpid()
+        elif how == "marshal":
+            copy = lambda dt: None  # noqa: E731 - its code is replaced just below
+            copy.__code__ = marshal.loads(marshal.dumps(model.transition_matrix.__code__))
+        elif how == "sys._getframe":
+            sys._getframe(1)
+        elif how == "a traceback's frame":
+            try:
+                raise ValueError
+            except ValueError as error:
+                assert error.__traceback__.tb_frame is not None
+        elif how == "the memory":
+            gc.get_objects()
         if how == "a thread":
             thread = threading.Thread(target=lambda: found.append(model.transition_matrix(dt)))
             thread.start()
@@ -155,8 +172,12 @@ def test_a_function_task_that_leaves_the_watch_is_refused(how):
         return np.array(found[0])
 
     said = {"sys.setprofile": "switches off the pack's watch of the functions it runs",
-            "C's PyEval_SetProfile": "switches off the pack's watch of the functions it runs",
+            "C's PyEval_SetProfile": "uses C code through ctypes",
             "a thread": "starts another thread",
-            "code.replace": "makes a code object by hand"}[how]
+            "code.replace": "makes a code object by hand",
+            "ctypes": "uses C code through ctypes", "marshal": "loads code with marshal",
+            "sys._getframe": "looks into the frames of the code that runs",
+            "a traceback's frame": "looks into the frames of a traceback",
+            "the memory": "searches the memory for objects"}[how]
     with pytest.raises(checks.CheckFailed, match=f"my_transition_matrix {said}"):
         checks.check_transition_matrix(my_transition_matrix, model.transition_matrix(0.01))
