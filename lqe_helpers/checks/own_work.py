@@ -223,6 +223,12 @@ def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
     drawn = sorted(found.cell.defines & set().union(
         *(cell.reads for cell in task_runs.ancestry(run))))
     names = ", ".join(drawn) or "a value"
+    if found.cell.given:  # given, yet on the trail: a cell from further on, run early
+        return (f"the task cell above uses {names} from a cell of the notebook that comes "
+                f"after this task (`{found.cell.first_line[:60]}`), which you ran before it: "
+                f"that cell runs {runs}, and what the pack computed there is not your own "
+                f"work. Make the values in the task cell with your own code, run it, then "
+                f"this check")
     return (f"the task cell above uses {names} from a cell you ran before it "
             f"(`{found.cell.first_line[:60]}`), and that cell runs {runs}: a value the pack "
             f"computed there and copied is not your own work. If that cell is one of yours, "

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from . import given_cells
 from . import outside as outside_module
 from .calling import in_pack, machinery_function, pack_name
 from .cell_code import (
@@ -320,9 +321,17 @@ def ancestry(run: TaskRun) -> list[TaskRun]:
 
     For each name a run reads (:attr:`TaskRun.reads`), the runs before it that define the
     name, latest first, up to the first that completed; then the same for those runs in
-    turn. A cell the pack gives (:attr:`TaskRun.given`) ends the trail: its values are the
-    notebook's own.
+    turn. A cell the pack gives (:attr:`TaskRun.given`) ends the trail if it comes before
+    the task in its notebook: its values are the notebook's own. One from further on (run
+    early, a later figure's model, say) ends it only for a name that a given cell before the
+    task makes too (an input made again, such as ``sigma_v``); for any other name it is
+    followed like the student's: the task's values must not come from it. Where the task
+    stands is the place of the cell running now (its check cell) or of ``run``'s
+    ``# Task:`` line; where neither is the pack's, every given cell ends the trail.
     """
+    anchor = given_cells.places(_RECORD.cell) or given_cells.places(run.source)
+    inputs = set().union(*(cell.defines for cell in _RECORD.runs if cell.given and (
+        given_cells.comes_before(cell.source, anchor))))
     found, queue = [run], [run]
     seen = {run.number}
     while queue:
@@ -331,7 +340,9 @@ def ancestry(run: TaskRun) -> list[TaskRun]:
             for earlier in reversed(_RECORD.runs):
                 if earlier.number >= reader.number or name not in earlier.defines:
                     continue
-                if not earlier.given and earlier.number not in seen:
+                ends = earlier.given and (not anchor or name in inputs or
+                                          given_cells.comes_before(earlier.source, anchor))
+                if not ends and earlier.number not in seen:
                     seen.add(earlier.number)
                     found.append(earlier)
                     queue.append(earlier)

@@ -963,3 +963,74 @@ def test_comparing_with_the_pack_after_a_passed_check_then_running_the_task_agai
         assert error is None and printed.getvalue().startswith("✓ "), (error, printed.getvalue())
     finally:
         runner.close()
+
+
+def _given_cell(notebook: str, starts: str) -> str:
+    """The code of ``notebook``'s given cell whose code starts with ``starts``."""
+    book = nbformat.read(NOTEBOOKS / f"{notebook}.ipynb", as_version=4)
+    return next(cell.source for cell in book.cells if cell.cell_type == "code"
+                and "solution" not in cell.metadata.get("tags", [])
+                and cell.source.startswith(starts))
+
+
+STAND_IN_FITS = ("import types\nfrom lqe_helpers import lowpass\n"
+                 "fits = {name: types.SimpleNamespace(amplitude=1.0, lead=0.0) "
+                 "for name in ('vision only', 'fused')}\n")
+
+
+@pytest.mark.slow
+def test_a_given_cell_from_further_on_run_early_does_not_lend_the_task_its_values(folder):
+    """The sixth trial (defect 5): 03's Going-further Figure 3 cell, a given cell, run before
+    Task 1 with a stand-in ``fits``, leaves ``settled_model``; ``C = settled_model.C.copy()``
+    passed, because any given cell ended the trail of values. A given cell ends it only if it
+    comes before the task in its notebook."""
+    figure_cell = _given_cell("03_fusion", "frequencies = np.geomspace")
+    copied = "C = settled_model.C.copy()\nR = settled_model.R.copy()\n"
+    error, printed = run_task("03_fusion", "check_fusion", copied,
+                              earlier=(STAND_IN_FITS, figure_cell))
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "a cell of the notebook that comes after this task" in str(error), str(error)
+    assert "experiments.filter_model" in str(error), str(error)
+    # The given cells before the task still end the trail: the worked answer passes after
+    # the same early run, and so does the task cell with its comment taken off.
+    error, printed = run_task("03_fusion", "check_fusion", None,
+                              earlier=(STAND_IN_FITS, figure_cell))
+    assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+def test_a_given_cell_ends_a_trail_only_before_its_task() -> None:
+    """given_cells.comes_before: by the places written by make notebooks (cell indices)."""
+    from lqe_helpers.student_code import given_cells
+
+    book = nbformat.read(NOTEBOOKS / "03_fusion.ipynb", as_version=4)
+    code = [(index, cell) for index, cell in enumerate(book.cells) if cell.cell_type == "code"]
+    first_given = next(cell.source for _, cell in code
+                       if "solution" not in cell.metadata.get("tags", []))
+    figure_cell = _given_cell("03_fusion", "frequencies = np.geomspace")
+    check_cell = _given_cell("03_fusion", "checks.check_fusion(")
+    task = next(cell.source for _, cell in code if "Build C, shape (2, 3)" in cell.source)
+    for anchor in (given_cells.places(check_cell), given_cells.places(task),
+                   given_cells.places(task_comment(task) + "C = 1\n")):
+        assert anchor and anchor[0][0] == "03_fusion", anchor
+        assert given_cells.comes_before(first_given, anchor)
+        assert not given_cells.comes_before(figure_cell, anchor)
+    assert given_cells.places("x = 1\n") == ()
+    assert not given_cells.comes_before("x = 1\n", given_cells.places(check_cell))
+
+
+@pytest.mark.slow
+def test_a_given_cell_from_further_on_that_makes_an_input_again_leaves_the_task_its_own(
+        folder, monkeypatch):
+    """Re-running a task after the rest of the notebook: a given cell further on that makes
+    an input again (``sigma_v``) and runs the pack is not where the task's values come from."""
+    from lqe_helpers.student_code import given_cells
+
+    later = ("sigma_v = 1.5\nlater_model = experiments.filter_model(DEFAULT, "
+             "('vision', 'proprioception'))\n")
+    monkeypatch.setitem(given_cells.GIVEN, given_cells.cell_key(later), (("03_fusion", 999),))
+    error, printed = run_task("03_fusion", "check_fusion", None, earlier=(later,))
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, printed = run_task("03_fusion", "check_fusion", "C = later_model.C.copy()\n"
+                              "R = np.diag([sigma_v**2, sigma_p**2])\n", earlier=(later,))
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "comes after this task" in str(error), str(error)
