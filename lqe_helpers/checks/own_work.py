@@ -220,21 +220,18 @@ def forbidden_text(found: Forbidden, run: task_runs.TaskRun) -> str:
                 f"made in the same cell the check cannot tell yours from it. Take that call "
                 f"out (compare with the pack in a new cell below this check, if you like), run "
                 f"the task cell, then this check again")
-    drawn = sorted(found.cell.defines & set().union(
-        *(cell.reads for cell in task_runs.ancestry(run))))
-    names = ", ".join(drawn) or "a value"
-    if found.cell.given:  # given, yet on the trail: a cell from further on, run early
-        return (f"the task cell above uses {names} from a cell of the notebook that comes "
-                f"after this task (`{found.cell.first_line[:60]}`), which you ran before it: "
-                f"that cell runs {runs}, and what the pack computed there is not your own "
-                f"work. Make the values in the task cell with your own code, run it, then "
-                f"this check")
-    return (f"the task cell above uses {names} from a cell you ran before it "
+    return (f"the task cell above uses {_drawn(found.cell, run)} from a cell you ran before it "
             f"(`{found.cell.first_line[:60]}`), and that cell runs {runs}: a value the pack "
             f"computed there and copied is not your own work. If that cell is one of yours, "
             f"make the values in the task cell with your own code; if it is a cell of the "
             f"notebook whose code you changed, put its code back as it was and run it again. "
             f"Then run the task cell and this check")
+
+
+def _drawn(cell: task_runs.TaskRun, run: task_runs.TaskRun) -> str:
+    """The names of ``cell``'s values that ``run`` draws on: "C, R" ("a value" if none)."""
+    names = cell.defines & set().union(*(other.reads for other in task_runs.ancestry(run)))
+    return ", ".join(sorted(names)) or "a value"
 
 
 def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
@@ -243,11 +240,17 @@ def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
     function of ``check``'s forbidden set ran there (:func:`forbidden_calls`), or the cell
     took something from outside the notebook (a file it read, another program it ran:
     :attr:`~lqe_helpers.student_code.task_runs.TaskRun.outside`), whose numbers the record
-    cannot trace."""
+    cannot trace; or the values come from a cell the notebook gives further on, run before
+    its turn."""
     used = forbidden_calls(check, run)
     if used:
         return forbidden_text(used[0], run)
     for cell in task_runs.ancestry(run):
+        if cell.given:  # on the trail, a given cell comes after the task (see ancestry)
+            return (f"the task cell above uses {_drawn(cell, run)} from a cell of the "
+                    f"notebook that comes after this task (`{cell.first_line[:60]}`), which "
+                    f"you ran before it: its values are the notebook's, not your own work. "
+                    f"Make them in the task cell with your own code, run it, then this check")
         if cell.outside:
             where = ("the task cell above" if cell.number == run.number else
                      f"a cell you ran before the task cell (`{cell.first_line[:60]}`), whose "

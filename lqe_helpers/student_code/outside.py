@@ -210,6 +210,11 @@ def use_of_outside(event: str, args: tuple) -> str:
     return f"reads the file {_shown(path)}"
 
 
+#: The built-in functions whose ``c_call`` :func:`c_call_use` names (a set: a profile hook
+#: asks for each C call).
+WATCHED_C_CALLS = frozenset({_thread.start_new_thread, *PROCESS_CALLS})
+
+
 def c_call_use(function: object) -> str:
     """What a profile hook's ``c_call`` of the built-in ``function`` takes from outside the
     watch, or "": another program (``os.system``, fork, exec), another thread."""

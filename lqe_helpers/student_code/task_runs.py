@@ -47,7 +47,7 @@ from .cell_code import (
     read_names,
 )
 from .given_cells import is_given
-from .outside import LOST_WATCH, c_call_use, dropping, starts_a_program
+from .outside import LOST_WATCH, WATCHED_C_CALLS, c_call_use, dropping, starts_a_program
 from .outside import watching as listening_outside
 
 #: Task runs kept (the most recent last).
@@ -92,7 +92,8 @@ class TaskRun:
         Whether its code starts with a ``# Task:`` comment (any other cell is recorded
         too, for the names it defines).
     given : bool
-        Whether its code is a cell the pack gives, unchanged (not the student's).
+        Whether its code is a cell the pack gives, unchanged (not the student's). Such a
+        cell runs unwatched: its pack calls, results and uses of the outside stay empty.
     reads : frozenset of str
         Names its code reads before it gives them a value (:func:`read_names`).
     completed : bool or None
@@ -105,7 +106,7 @@ class TaskRun:
         For each of those names, the function of the pack the cell itself called that ran
         it (the same name for a function the cell called).
     results : list of (str, numpy.ndarray)
-        In a cell of the student's (not given): the small numeric results (numbers and
+        The small numeric results (numbers and
         arrays of at most :data:`RESULT_SIZE` numbers, copied) of the pack's functions it
         ran, each with the function's name, at most :data:`RESULTS_KEPT`.
     outside : list of str
@@ -167,8 +168,10 @@ class _Record:
                       given=is_given(source), reads=read_names(source))
         self.current = run
         self.previous_profile = previous = sys.getprofile()
+        if run.given:  # the pack's own code, never the student's work (see ancestry): no
+            self.noting = previous  # hook, so that its figures and explorers run at speed
+            return
         pack_calls, entries, results = run.pack_calls, run.entries, run.results
-        keep_results = not run.given
         entry = ["", 0]  # the pack function the cell itself called last; pack frames open
 
         def outside(what: str) -> None:
@@ -176,28 +179,40 @@ class _Record:
                 run.outside.append(what)
 
         def noting(frame: types.FrameType, event: str, arg: object) -> None:
+            # Most events are a library's (numpy's, matplotlib's): they leave first.
+            if previous is None and (event == "c_return" or event == "c_exception"):
+                return
             try:
                 if previous is not None:
                     previous(frame, event, arg)
+                if event == "c_call":
+                    if arg in WATCHED_C_CALLS:
+                        outside(c_call_use(arg))
+                    return
+                if event != "call" and event != "return":
+                    return
+                module = frame.f_globals
+                if id(module) in _libraries:
+                    return
+                if id(module) not in _not_libraries and _is_library(module):
+                    return
                 if event == "call":
                     code = frame.f_code
                     name = pack_calls.get(code)
                     if name is None:
                         if not in_pack(code.co_filename):
                             if starts_a_program(code.co_filename):
-                                module = str(frame.f_globals.get("__name__", "subprocess"))
-                                outside(f"runs another program ({module.split('.')[0]})")
+                                named = str(module.get("__name__", "subprocess"))
+                                outside(f"runs another program ({named.split('.')[0]})")
                             return
                         name = pack_calls[code] = pack_name(frame)
                     if not entry[1]:
                         entry[0] = name
                     entry[1] += 1
                     entries.setdefault(name, entry[0])
-                elif event == "c_call" and c_call_use(arg):
-                    outside(c_call_use(arg))
-                elif event == "return" and frame.f_code in pack_calls:
+                elif frame.f_code in pack_calls:  # its return
                     entry[1] = max(entry[1] - 1, 0)
-                    if keep_results and len(results) < RESULTS_KEPT:
+                    if len(results) < RESULTS_KEPT:
                         kept = _small_result(arg)
                         if kept is not None:
                             results.append((pack_calls[frame.f_code], kept))
@@ -239,6 +254,25 @@ class _Record:
 
 
 _RECORD = _Record()
+#: The ids of the globals of the modules seen by a cell's profile hook: a library's, not a
+#: library's. Their globals are kept (:data:`_seen`), so that an id is never reused.
+_libraries: set[int] = set()
+_not_libraries: set[int] = set()
+_seen: list[dict] = []
+
+
+def _is_library(module: dict) -> bool:
+    """Whether code with the globals ``module`` is a library's (numpy's, matplotlib's): a
+    module with a file outside the pack that runs no other program. Noted on first sight;
+    the notebook's namespace, the pack's modules and code made with other globals are not
+    libraries."""
+    filename = module.get("__file__")
+    library = (isinstance(filename, str) and not in_pack(filename)
+               and not starts_a_program(filename)
+               and not str(module.get("__name__", "")).startswith("lqe_helpers"))
+    _seen.append(module)
+    (_libraries if library else _not_libraries).add(id(module))
+    return library
 
 
 def watch_task_cells(shell: object) -> None:
@@ -273,7 +307,8 @@ def run_for(check: str) -> TaskRun | None:
         return None
     names = set(argument_names(_RECORD.cell, check))
     now = _RECORD.current
-    if now is not None and names & now.defines:  # the task written in the check's own cell
+    if now is not None and not now.given and names & now.defines:  # the task written in
+        # the check's own cell (a given check cell that keeps the function it judged is not)
         return dataclasses.replace(  # as far as it ran: its pack calls up to this check
             now, completed=True, saved_calls=list(now.saved_calls),
             pack_calls={code: name for code, name in list(now.pack_calls.items())
@@ -324,8 +359,9 @@ def ancestry(run: TaskRun) -> list[TaskRun]:
     turn. A cell the pack gives (:attr:`TaskRun.given`) ends the trail if it comes before
     the task in its notebook: its values are the notebook's own. One from further on (run
     early, a later figure's model, say) ends it only for a name that a given cell before the
-    task makes too (an input made again, such as ``sigma_v``); for any other name it is
-    followed like the student's: the task's values must not come from it. Where the task
+    task makes too (an input made again, such as ``sigma_v``); for any other name it is on
+    the trail, and the task's values must not come from it (its code is not followed: it is
+    the pack's, and its run unwatched). Where the task
     stands is the place of the cell running now (its check cell) or of ``run``'s
     ``# Task:`` line; where neither is the pack's, every given cell ends the trail.
     """
@@ -345,7 +381,8 @@ def ancestry(run: TaskRun) -> list[TaskRun]:
                 if not ends and earlier.number not in seen:
                     seen.add(earlier.number)
                     found.append(earlier)
-                    queue.append(earlier)
+                    if not earlier.given:
+                        queue.append(earlier)
                 if earlier.completed:
                     break
     return found
