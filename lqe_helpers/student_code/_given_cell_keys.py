@@ -3,6 +3,7 @@ python -m lqe_helpers.authoring.given_cells."""
 
 GIVEN: frozenset[str] = frozenset({
     "00f4ad31e232901e",
+    "0294ceb4c4256028",
     "042724c4c6d8e568",
     "06a8a6791c14709c",
     "083de2243a166a72",
@@ -22,7 +23,6 @@ GIVEN: frozenset[str] = frozenset({
     "2426772fd0d69193",
     "24368420c0b1d5b8",
     "2516c422e14cc39b",
-    "260380c2c5d2be8e",
     "28e49b8ae2c140ca",
     "30660a83e4dbc7f9",
     "33050355bb87ec92",
@@ -48,7 +48,6 @@ GIVEN: frozenset[str] = frozenset({
     "57e8c2ad97d7a978",
     "58fd85ca46efcda6",
     "6032f59c671c29d5",
-    "61e4335c7c7af692",
     "626fad574f52f599",
     "6384a31414fd8881",
     "64aa00801de66247",
@@ -141,6 +140,7 @@ GIVEN: frozenset[str] = frozenset({
     "f5dc6551374f958b",
     "f6a6f6c77edbcc99",
     "f944ef4ef2edca7b",
+    "fc14268fb24cd040",
     "fc95e556cf218fd9",
     "fca12c8cdec592e5",
     "fcb6f80411ae48f7",
