@@ -21,7 +21,7 @@ import numpy as np
 from . import experiments, model, validation
 from .experiments import DelayedTracking
 from .scenario import DEFAULT, Scenario
-from .systematic_error import NoiseFreeOutputs, positions_by_sigma
+from .systematic_error import NoiseFreeOutputs, is_sigma_key, positions_by_sigma
 
 
 def _columns(name: str, values: object, n: int, what: str) -> np.ndarray:
@@ -172,11 +172,9 @@ def noise_free(filtered: Mapping[float, np.ndarray], smoothed: Mapping[float, np
     n = scenario.n_steps
     filtered = positions_by_sigma("filtered", filtered, n)
     smoothed = positions_by_sigma("smoothed", smoothed, n, list(filtered))
-    try:
-        weights = {float(sigma): alpha for sigma, alpha in alphas.items()}
-    except (AttributeError, TypeError, ValueError):
-        weights = {}
-    if sorted(weights) != sorted(filtered):
+    weights = {float(sigma): alpha for sigma, alpha in alphas.items()
+               if is_sigma_key(sigma)} if isinstance(alphas, Mapping) else {}
+    if not weights or len(weights) != len(alphas) or sorted(weights) != sorted(filtered):
         raise ValueError("alphas must map each σ_v of filtered ("
                          + ", ".join(f"{sigma:g}" for sigma in filtered)
                          + f" cm) to a weight in (0, 1], got {alphas!r}")

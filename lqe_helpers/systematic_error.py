@@ -15,6 +15,7 @@ painters of :mod:`lqe_helpers.figures.vision` (imported when a figure is asked f
 
 from __future__ import annotations
 
+import numbers
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
@@ -29,6 +30,11 @@ if TYPE_CHECKING:
 
 #: Style roles of :func:`error_figure`'s panels, one per σ_v, in the sweep's order.
 PANEL_ROLES = ("estimate", "alternative", "reference")
+
+
+def is_sigma_key(key: object) -> bool:
+    """Whether ``key`` may stand for a σ_v in a mapping: a real number, not a bool or text."""
+    return isinstance(key, numbers.Real) and not isinstance(key, bool)
 
 
 def positions_by_sigma(name: str, values: object, n: int,
@@ -51,9 +57,8 @@ def positions_by_sigma(name: str, values: object, n: int,
     wanted = "σ_v > 0 (cm)" if sigmas is None else (
         "each σ_v of the run (" + ", ".join(f"{sigma:g}" for sigma in sigmas) + " cm)")
     keys = list(values) if isinstance(values, Mapping) else []
-    try:
-        numbers = [float(key) for key in keys]
-    except (TypeError, ValueError):
+    numbers = [float(key) for key in keys if is_sigma_key(key)]
+    if len(numbers) != len(keys):
         numbers = []
     if not numbers or not all(np.isfinite(numbers)) or min(numbers) <= 0 or (
             sigmas is not None and (len(numbers) != len(sigmas) or not all(

@@ -209,6 +209,8 @@ def test_noise_free_keeps_the_order_of_filtered_and_copies_the_arrays() -> None:
      r"alphas must map each σ_v of filtered \(1.5, 4.5 cm\) to a weight in \(0, 1\], got "
      r"\{1.5: 0.1\}"),
     (lambda f, s, a: (f, s, [0.1, 0.2]), r"alphas must map each σ_v .* got \[0.1, 0.2\]"),
+    (lambda f, s, a: (f, s, 0.1), r"alphas must map each σ_v .* got 0.1"),
+    (lambda f, s, a: (f, s, {"1.5": 0.1, 4.5: 0.1}), r"alphas must map .* got \{'1.5': 0.1"),
     (lambda f, s, a: (f, s, {1.5: 0.1, 4.5: 1.5}), r"alphas\[4.5\] must be in \(0, 1\], got 1.5"),
     (lambda f, s, a: (f, s, {1.5: 0.0, 4.5: 0.1}), r"alphas\[1.5\] must be in \(0, 1\], got 0"),
     (lambda f, s, a: (f, s, {1.5: "x", 4.5: 0.1}), r"alphas\[1.5\]"),

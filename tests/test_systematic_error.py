@@ -94,6 +94,8 @@ def test_the_noise_free_keys_match_the_sweep_in_any_order(batch) -> None:
     ({1.5: np.zeros(N), 3.0: np.zeros(N)}, r"got keys \[1.5, 3.0\]"),
     ({1.5: np.zeros(N), 4.5: np.zeros(N), 6.0: np.zeros(N)}, "noise_free must map each σ_v"),
     ({"a": np.zeros(N), 4.5: np.zeros(N)}, r"got keys \['a', 4.5\]"),
+    ({"1.5": np.zeros(N), 4.5: np.zeros(N)}, r"got keys \['1.5', 4.5\]"),
+    ({True: np.zeros(N), 4.5: np.zeros(N)}, r"got keys \[True, 4.5\]"),
     ([np.zeros(N), np.zeros(N)], "noise_free must map .* got list"),
     ({1.5: np.zeros(N - 1), 4.5: np.zeros(N)},
      r"noise_free\[1.5\] must be finite positions \(cm\) of shape \(1000,\), got shape "
