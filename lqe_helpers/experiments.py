@@ -4,9 +4,9 @@ Notebooks, explorers and checks call these instead of assembling C, R, P0 and no
 by hand, so a question's setup is written once: :func:`filter_model` is the one
 builder of the model a filter assumes (A, C, Q, R, z0, P0), :func:`track` simulates
 the sensors and runs that filter, :func:`delay_and_compensate` delays its output.
-Their results draw their own standard figures (:meth:`Tracking.figure`,
-:meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only
-when a figure is asked for). :mod:`lqe_helpers.own_runs` wraps a student's own arrays in them.
+Their results draw their own standard figures (:meth:`Tracking.figure`, ``.error_figure``,
+:meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only when a
+figure is asked for); :mod:`lqe_helpers.own_runs` wraps a student's own arrays in them.
 
 Each public function checks its inputs once, at its entry; what it calls inside
 (:mod:`lqe_helpers._matrices`) checks nothing again.
@@ -223,6 +223,13 @@ class Tracking:
         return figures.tracking_comparison_figure(self.scenario.times, self.scenario.truth[:, 0],
                                                   estimates, readings=shown, title=title)
 
+    def error_figure(self, noise_free: Mapping[float, np.ndarray], *,
+                     run: int | tuple[int, ...] | None = 0) -> Figure:
+        """:func:`lqe_helpers.systematic_error.error_figure` of this sweep over σ_v and
+        ``noise_free`` (σ_v → noise-free positions (cm), (n,)): run ``run``'s errors."""
+        from . import systematic_error
+        return systematic_error.error_figure(self, noise_free, run=run)
+
 
 def _sensor_sigmas(name: str, sigmas: object, sensors: tuple[str, ...]) -> np.ndarray:
     """``sigmas`` (cm) as an array of shape (..., m): finite, > 0, one σ per sensor."""
@@ -295,8 +302,7 @@ def filter_model(scenario: Scenario, sensors: Sequence[str] = ("vision",),
 
 def _default_sigmas(scenario: Scenario, sensors: tuple[str, ...]) -> list[float]:
     """The scenario's σ of each sensor (cm)."""
-    defaults = {"vision": scenario.sigma_v, "proprioception": scenario.sigma_p}
-    return [defaults[sensor] for sensor in sensors]
+    return [scenario.sigma_v if sensor == "vision" else scenario.sigma_p for sensor in sensors]
 
 
 def readings(scenario: Scenario, sensors: Sequence[str] = ("vision",),

@@ -4,8 +4,9 @@ The notebooks' one-trial tasks make readings and estimates with the student's ow
 ``my_filter`` and ``compensate``; the figures after them show exactly those arrays. These
 functions check them once and wrap them in the results the pack's engine makes
 (:class:`~lqe_helpers.experiments.Tracking`,
-:class:`~lqe_helpers.experiments.DelayedTracking`), which draw themselves: a notebook passes
-one object, not six arrays. Nothing here estimates anything: the estimates are the
+:class:`~lqe_helpers.experiments.DelayedTracking`,
+:class:`~lqe_helpers.systematic_error.NoiseFreeOutputs`), which draw themselves: a notebook
+passes one object, not six arrays. Nothing here estimates anything: the estimates are the
 student's; the gains and covariances a result carries are the engine's for the same
 readings and model (they do not depend on the readings), for a band or a gain only.
 """
@@ -13,13 +14,14 @@ readings and model (they do not depend on the readings), for a band or a gain on
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 
 from . import experiments, model, validation
 from .experiments import DelayedTracking
 from .scenario import DEFAULT, Scenario
+from .systematic_error import NoiseFreeOutputs, is_sigma_key, positions_by_sigma
 
 
 def _columns(name: str, values: object, n: int, what: str) -> np.ndarray:
@@ -131,3 +133,56 @@ def delayed(run: experiments.Tracking, delay: float, late_readings: np.ndarray,
         shifted[name] = array
     return DelayedTracking(run, steps, shifted["late_readings"], shifted["delayed_positions"],
                            shifted["compensated"])
+
+
+def noise_free(filtered: Mapping[float, np.ndarray], smoothed: Mapping[float, np.ndarray],
+               alphas: Mapping[float, float], *,
+               scenario: Scenario = DEFAULT) -> NoiseFreeOutputs:
+    """The student's filter and smoother fed noise-free readings, as :class:`NoiseFreeOutputs`.
+
+    Notebook 01's Figure 4: ``.figure(window)`` draws both beside the true path.
+
+    Parameters
+    ----------
+    filtered : mapping
+        σ_v (cm) → the positions (cm), shape (n,), of ``my_filter`` fed the true positions
+        with R = [[σ_v²]].
+    smoothed : mapping
+        The same σ_v → the exponential smoother's output (cm), shape (n,), on the true
+        positions with that σ_v's weight.
+    alphas : mapping
+        The same σ_v → the smoother's weight α, in (0, 1].
+    scenario : Scenario
+        The trial's constants (times, true path).
+
+    Returns
+    -------
+    NoiseFreeOutputs
+        By σ_v: "LQE (your my_filter)" (the estimate's role), then "exponential smoother,
+        α = …" (the alternative's).
+
+    Raises
+    ------
+    ValueError
+        If ``scenario`` is not a Scenario, ``filtered`` does not map σ_v > 0 to finite
+        positions of shape (n,), ``smoothed`` does not do so for the same σ_v, or
+        ``alphas`` does not map them to numbers in (0, 1].
+    """
+    validation.instance("scenario", scenario, Scenario, "e.g. scenario.DEFAULT")
+    n = scenario.n_steps
+    filtered = positions_by_sigma("filtered", filtered, n)
+    smoothed = positions_by_sigma("smoothed", smoothed, n, list(filtered))
+    weights = {float(sigma): alpha for sigma, alpha in alphas.items()
+               if is_sigma_key(sigma)} if isinstance(alphas, Mapping) else {}
+    if not weights or len(weights) != len(alphas) or sorted(weights) != sorted(filtered):
+        raise ValueError("alphas must map each σ_v of filtered ("
+                         + ", ".join(f"{sigma:g}" for sigma in filtered)
+                         + f" cm) to a weight in (0, 1], got {alphas!r}")
+    outputs = {}
+    for (sigma, lqe), smooth in zip(filtered.items(), smoothed.values(), strict=True):
+        alpha = validation.finite_number(f"alphas[{sigma:g}]", weights[sigma])
+        if not 0 < alpha <= 1:
+            raise ValueError(f"alphas[{sigma:g}] must be in (0, 1], got {alpha:g}")
+        outputs[sigma] = {"LQE (your my_filter)": (lqe, "estimate"),
+                          f"exponential smoother, α = {alpha:.2f}": (smooth, "alternative")}
+    return NoiseFreeOutputs(scenario, outputs)

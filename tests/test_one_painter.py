@@ -3,7 +3,9 @@
 Each explorer's picture is built by the painters its row of docs/architecture.md's pictures
 table names (``draw_fusion``: ``fusion_panels``, ``trial_panels``, ``trial_column``), and
 by no other; ``explorers/`` holds no matplotlib drawing call outside its framework, so a
-second painter written there fails here. A trial's signals over its errors is drawn by
+second painter written there fails here. A notebook's figure drawn by a result's method
+(``Tracking.error_figure``, ``NoiseFreeOutputs.figure``, …) is drawn by the one painter
+its entry in the table names. A trial's signals over its errors is drawn by
 :func:`lqe_helpers.figures.common.trial_column` only, for the notebooks' figure and for the
 explorers of 01, 03, 04 and 05.
 """
@@ -139,6 +141,63 @@ def test_the_explorers_trial_is_painted_by_the_same_function(painted, drawer) ->
     assert len(trials) == 1
     drawn = {line.get_gid() for ax in explorer.figure.axes for line in ax.get_lines()}
     assert set(trials[0]) <= drawn
+
+
+def result_methods_in_table() -> dict[str, str]:
+    """By ``Result.method`` the table names for a notebook's figure, the painter it names."""
+    text = (ROOT / "docs" / "architecture.md").read_text(encoding="utf-8")
+    section = text[text.index("## Each picture and its one drawing function"):
+                   text.index("## Where to change what")]
+    rows = re.findall(r"^\| \d\d \|(.*)\| `draw_\w+`", section, re.MULTILINE)
+    return dict(pair for row in rows
+                for pair in re.findall(r"`(\w+\.\w+)` \(`(\w+)`", row))
+
+
+def _draw_result_figure(method: str) -> plt.Figure:
+    """The figure ``method`` (``Result.method``) draws of a small result of the pack."""
+    from lqe_helpers import bias_model, own_runs
+
+    truth = DEFAULT.truth[:, 0]
+    clean = {sigma: truth + 0.1 * sigma for sigma in (1.5, 4.5)}
+    delayed = experiments.delay_and_compensate(experiments.track(DEFAULT), 0.1)
+    calls = {
+        "Tracking.figure": lambda: experiments.track(DEFAULT).figure(),
+        "Tracking.error_figure": lambda: experiments.track(
+            DEFAULT, sigmas=[[1.5], [4.5]], runs=2).error_figure(clean),
+        "NoiseFreeOutputs.figure": lambda: own_runs.noise_free(
+            clean, clean, {1.5: 0.1, 4.5: 0.05}).figure(),
+        "DelayedTracking.figure": delayed.figure,
+        "DelayedTracking.comparison_figure": delayed.comparison_figure,
+        "InputTracking.learning_figure": lambda: bias_model.track_with_input(
+            DEFAULT).learning_figure(bias_model.track_with_input(DEFAULT, runs=2)),
+    }
+    return calls[method]()
+
+
+def test_the_table_names_the_result_methods_of_notebook_01s_figures() -> None:
+    table = result_methods_in_table()
+    assert table["Tracking.figure"] == "tracking_comparison_figure"
+    assert table["NoiseFreeOutputs.figure"] == "lag_figure"
+    assert table["Tracking.error_figure"] == "estimate_error_figure"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("method", sorted(result_methods_in_table()))
+def test_each_result_method_hands_its_data_to_the_painter_its_entry_names(
+        monkeypatch, method) -> None:
+    """A result draws itself through one painter of figures/, the one the table names."""
+    called = []
+    for name in figures_package.__all__:
+        original = getattr(figures_package, name)
+
+        def recording(*args, __name=name, __original=original, **kwargs):
+            called.append(__name)
+            return __original(*args, **kwargs)
+
+        monkeypatch.setattr(figures_package, name, recording)
+    fig = _draw_result_figure(method)
+    plt.close(fig)
+    assert called == [result_methods_in_table()[method]]
 
 
 def drawing_calls(path: Path) -> list[str]:

@@ -145,3 +145,84 @@ def test_delayed_refuses_bad_input_naming_the_parameter() -> None:
         own_runs.delayed(run, 0.1, late, delayed, np.zeros((N, 3)))
     with pytest.raises(ValueError, match="late_readings must be positions"):
         own_runs.delayed(run, 0.1, late[:-1], delayed, compensated)
+
+
+def _noise_free_arrays() -> tuple[dict, dict, dict]:
+    """Notebook 01's Figure 4 inputs: a 'student's' noise-free filter and smoother outputs
+    by σ_v (not the engine's), and the smoother's weights (numpy floats, as np.argmin picks)."""
+    truth = DEFAULT.truth[:, 0]
+    filtered = {1.5: truth + 0.1 * np.cos(3 * DEFAULT.times), 4.5: truth * 1.02}
+    smoothed = {1.5: np.roll(truth, 5), 4.5: np.roll(truth, 9)}
+    return filtered, smoothed, {1.5: np.float64(0.14), 4.5: np.float64(0.06)}
+
+
+def test_noise_free_draws_the_students_outputs_as_the_lag_figure_of_their_arrays() -> None:
+    """Notebook 01's Figure 4: ``own_runs.noise_free(...).figure()`` is the painter's figure
+    of the arrays its cell passed before, line for line and pixel for pixel."""
+    filtered, smoothed, alphas = _noise_free_arrays()
+    truth = DEFAULT.truth[:, 0]
+    by_arrays = figures.lag_figure(DEFAULT.times, truth, {
+        f"σ_v = {s} cm": {"LQE (your my_filter)": (filtered[s], "estimate"),
+                          f"exponential smoother, α = {alphas[s]:.2f}": (smoothed[s],
+                                                                       "alternative")}
+        for s in (1.5, 4.5)}, window=(4.1, 5.1))
+    own = own_runs.noise_free(filtered, smoothed, alphas)
+    by_object = own.figure(window=(4.1, 5.1))
+    shown = (DEFAULT.times >= 4.1) & (DEFAULT.times <= 5.1)
+    try:
+        assert png(by_object, dpi=30) == png(by_arrays, dpi=30)
+        for ax, sigma in zip(by_object.axes, (1.5, 4.5), strict=True):
+            truth_line, lqe, smoother = ax.get_lines()
+            np.testing.assert_array_equal(truth_line.get_ydata(), truth[shown])
+            np.testing.assert_array_equal(lqe.get_ydata(), filtered[sigma][shown])
+            np.testing.assert_array_equal(smoother.get_ydata(), smoothed[sigma][shown])
+            assert [lqe.get_label(), smoother.get_label()] == [
+                "LQE (your my_filter)", f"exponential smoother, α = {alphas[sigma]:.2f}"]
+            assert ax.get_title() == f"σ_v = {sigma} cm"
+        swapped = own_runs.noise_free(smoothed, filtered, alphas).figure(window=(4.1, 5.1))
+        assert png(swapped, dpi=30) != png(by_arrays, dpi=30)
+    finally:
+        plt.close("all")
+
+
+def test_noise_free_keeps_the_order_of_filtered_and_copies_the_arrays() -> None:
+    filtered, smoothed, alphas = _noise_free_arrays()
+    backwards = {4.5: smoothed[4.5], 1.5: smoothed[1.5]}
+    own = own_runs.noise_free(filtered, backwards, alphas)
+    assert list(own.outputs) == [1.5, 4.5]
+    np.testing.assert_array_equal(own.outputs[1.5]["exponential smoother, α = 0.14"][0],
+                                  smoothed[1.5])
+    filtered[1.5][:] = 0.0
+    assert np.any(own.outputs[1.5]["LQE (your my_filter)"][0] != 0.0)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda f, s, a: (f, {1.5: s[1.5]}, a),
+     r"smoothed must map each σ_v of the run \(1.5, 4.5 cm\) to positions \(cm\) of shape "
+     r"\(1000,\), got keys \[1.5\]"),
+    (lambda f, s, a: ({1.5: f[1.5][:-1], 4.5: f[4.5]}, s, a),
+     r"filtered\[1.5\] must be finite positions \(cm\) of shape \(1000,\), got shape \(999,\)"),
+    (lambda f, s, a: ({-1.5: f[1.5]}, s, a), r"filtered must map σ_v > 0 \(cm\) to positions"),
+    (lambda f, s, a: (f, {1.5: s[1.5], 4.5: np.full(N, np.nan)}, a),
+     r"smoothed\[4.5\] must be finite .* with NaN or infinite values"),
+    (lambda f, s, a: (f, s, {1.5: 0.1}),
+     r"alphas must map each σ_v of filtered \(1.5, 4.5 cm\) to a weight in \(0, 1\], got "
+     r"\{1.5: 0.1\}"),
+    (lambda f, s, a: (f, s, [0.1, 0.2]), r"alphas must map each σ_v .* got \[0.1, 0.2\]"),
+    (lambda f, s, a: (f, s, 0.1), r"alphas must map each σ_v .* got 0.1"),
+    (lambda f, s, a: (f, s, {"1.5": 0.1, 4.5: 0.1}), r"alphas must map .* got \{'1.5': 0.1"),
+    (lambda f, s, a: (f, s, {1.5: 0.1, 4.5: 1.5}), r"alphas\[4.5\] must be in \(0, 1\], got 1.5"),
+    (lambda f, s, a: (f, s, {1.5: 0.0, 4.5: 0.1}), r"alphas\[1.5\] must be in \(0, 1\], got 0"),
+    (lambda f, s, a: (f, s, {1.5: "x", 4.5: 0.1}), r"alphas\[1.5\]"),
+])
+def test_noise_free_refuses_bad_input_naming_the_parameter(change, message) -> None:
+    with pytest.raises(ValueError, match=message):
+        own_runs.noise_free(*change(*_noise_free_arrays()))
+
+
+def test_noise_free_refuses_a_bad_scenario_or_window() -> None:
+    with pytest.raises(ValueError, match="scenario"):
+        own_runs.noise_free(*_noise_free_arrays(), scenario="DEFAULT")
+    own = own_runs.noise_free(*_noise_free_arrays())
+    with pytest.raises(ValueError, match=r"window must be \(start, end\)"):
+        own.figure(window=(5.1, 4.1))

@@ -23,12 +23,15 @@ from matplotlib.ticker import (
 
 from ..plotting import COLORS, label_time_position, style
 from .common import (
+    ESTIMATE_LABEL,
+    VISION_LABEL,
     errorbar_intervals,
     interval_arrays,
     label_axes,
     plain_log_ticks,
     plot_series,
 )
+from .common import TRUE_PATH_LABEL as TRUTH_LABEL  # the explorer's truth line
 
 
 def open_loop_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
@@ -70,9 +73,9 @@ def open_loop_figure(times: np.ndarray, truth: np.ndarray, readings: np.ndarray,
     seen = times <= close
     shown = times <= end
     fig, ax = plt.subplots(figsize=(10, 4.5))
-    plot_series(ax, times, [(readings, "vision", "vision")], seen)
-    plot_series(ax, times, [(truth, "truth", "true path")], shown)
-    plot_series(ax, times, [(estimate, "estimate", "filtered estimate")], seen)
+    plot_series(ax, times, [(readings, "vision", VISION_LABEL)], seen)
+    plot_series(ax, times, [(truth, "truth", TRUTH_LABEL)], shown)
+    plot_series(ax, times, [(estimate, "estimate", ESTIMATE_LABEL)], seen)
     ax.plot(prediction_times, prediction,
             **style("prediction", label="prediction with eyes closed"))
     ax.fill_between(prediction_times, prediction - 2 * prediction_std,
@@ -251,8 +254,8 @@ def tracking_panels_figure(times: np.ndarray, truth: np.ndarray, readings: np.nd
     fig, axes = plt.subplots(1, len(panels), figsize=(4 * len(panels), 4), sharey=True,
                              squeeze=False)
     for ax, (title, estimate) in zip(axes[0], panels.items(), strict=True):
-        plot_series(ax, times, [(readings, "vision", "vision"), (truth, "truth", "true path"),
-                                (estimate, "estimate", "filtered estimate")], shown)
+        plot_series(ax, times, [(readings, "vision", VISION_LABEL), (truth, "truth", TRUTH_LABEL),
+                                (estimate, "estimate", ESTIMATE_LABEL)], shown)
         ax.set_title(title, fontsize=9)
         label_axes(ax, "time (s)", xlim=(start, end))
     label_axes(axes[0, 0], ylabel="position (cm)",
@@ -340,9 +343,6 @@ TITLE_PAD = 10.0
 GROWTH_LABEL = "2σ at this σ_j"
 REFERENCE_LABEL = "2σ at the scenario's σ_j"
 AMPLITUDE_LABEL = "flight amplitude"
-VISION_LABEL = "vision"
-TRUTH_LABEL = "true path"
-ESTIMATE_LABEL = "filtered estimate"
 
 
 class BackgroundPanels(NamedTuple):

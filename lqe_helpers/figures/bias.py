@@ -17,7 +17,17 @@ from matplotlib.lines import Line2D
 from matplotlib.ticker import MultipleLocator
 
 from ..plotting import COLORS, DATA_UNDER_LINES, label_time_position, style
-from .common import errorbar_intervals, first_seconds, label_axes, plot_series
+from .common import (
+    BAND_LABEL,
+    ESTIMATE_LABEL,
+    VISION_LABEL,
+    VISION_ONLY_LABEL,
+    errorbar_intervals,
+    first_seconds,
+    label_axes,
+    plot_series,
+)
+from .common import TRUE_PATH_LABEL as TRUTH_LABEL  # the explorer's truth line
 
 _LEGEND_UPPER_RIGHT = {"loc": "upper right", "fontsize": 8}
 #: Both axes logarithmic, legend at the upper left: the sweeps over a noise level.
@@ -61,7 +71,7 @@ def bias_learning_figure(times: np.ndarray, estimate: np.ndarray, std: np.ndarra
     fig, (ax_run, ax_mc) = plt.subplots(1, 2, figsize=(12, 4.2))
     ax_run.fill_between(times[early], estimate[early] - 2 * std[early],
                         estimate[early] + 2 * std[early], color=COLORS["estimate"],
-                        alpha=0.15, linewidth=0, label="±2σ of the filter's own variance")
+                        alpha=0.15, linewidth=0, label=BAND_LABEL)
     plot_series(ax_run, times, [(np.full(times.size, float(bias)), "truth", "true bias"),
                                 (estimate, "estimate", "bias estimate")], early)
     label_axes(ax_run, "time (s)", "bias (cm/s²)", "One run: the bias estimate and its band",
@@ -188,7 +198,7 @@ def noise_sweep_figure(values: np.ndarray, intervals, baseline, bias_rms: np.nda
                        **style("estimate", label="with the signal (95 % CI)"))
     ax_mse.axhspan(float(baseline.low), float(baseline.high), color=COLORS["alternative"],
                    alpha=0.3, linewidth=0)
-    ax_mse.axhline(float(baseline.mean), **style("alternative", label="vision only"))
+    ax_mse.axhline(float(baseline.mean), **style("alternative", label=VISION_ONLY_LABEL))
     ax_bias.plot(values, np.asarray(bias_rms, dtype=float), marker="o", markersize=4,
                  **style("estimate", label="RMS error of b̂ at the end"))
     ax_bias.plot(values, np.asarray(bias_std, dtype=float),
@@ -250,9 +260,6 @@ BIAS_TICK = 40.0
 TRUE_BIAS_LABEL = "true bias"
 BIAS_ESTIMATE_LABEL = "estimated bias"
 BIAS_BAND_LABEL = "±2σ"
-TRUTH_LABEL = "true path"
-VISION_LABEL = "vision"
-ESTIMATE_LABEL = "filtered estimate"
 DEAD_RECKONING_LABEL = "dead reckoning"
 #: Titles of the explorer's two panels; they never change (cached background).
 BIAS_TITLE = "bias of the acceleration signal"

@@ -32,6 +32,17 @@ Series = tuple[np.ndarray, str, "str | None"]
 #: None). Panel 0 holds the signals, panel 1 the errors (estimate − true position).
 TrialLine = tuple[int, str, "str | None"]
 
+#: Legend labels several pictures share, written once: the figures draw them and the
+#: explorers (and their tests) find their artists by them.
+TRUE_POSITION_LABEL = "true position"
+TRUE_PATH_LABEL = "true path"
+VISION_LABEL = "vision"
+NOISY_VISION_LABEL = "noisy vision"
+VISION_READINGS_LABEL = "vision readings"
+VISION_ONLY_LABEL = "vision only"
+ESTIMATE_LABEL = "filtered estimate"
+BAND_LABEL = "±2σ of the filter's own variance"
+
 
 def interval_arrays(intervals: Iterable) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Means, lower and upper ends of a sequence of ``metrics.Interval`` (or alike), (s,) each.
@@ -320,7 +331,7 @@ def tracking_comparison_figure(times: np.ndarray, truth: np.ndarray,
     values: dict[str, np.ndarray] = {}
     for label, (series, role) in (readings or {}).items():
         lines[f"reading: {label}"], values[f"reading: {label}"] = (0, role, label), series
-    lines["truth"], values["truth"] = (0, "truth", "true position"), truth
+    lines["truth"], values["truth"] = (0, "truth", TRUE_POSITION_LABEL), truth
     for label, (series, role) in estimates.items():
         series = np.asarray(series, dtype=float)
         lines[f"estimate: {label}"], values[f"estimate: {label}"] = (0, role, label), series

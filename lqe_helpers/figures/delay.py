@@ -19,6 +19,7 @@ from matplotlib.patches import Patch, Rectangle
 
 from ..plotting import COLORS, DATA_UNDER_LINES, style
 from .common import (
+    TRUE_POSITION_LABEL,
     TrialLine,
     interval_arrays,
     label_axes,
@@ -66,7 +67,7 @@ def delay_figure(times: np.ndarray, truth: np.ndarray, delayed_readings: np.ndar
         raise ValueError(f"delay must be > 0 s, got {delay}")
     series = [
         (delayed_readings, "vision", r"vision, delayed $y_{j-\delta}$"),
-        (truth, "truth", "true position"),
+        (truth, "truth", TRUE_POSITION_LABEL),
         (delayed_estimate, "estimate", r"delayed estimate $\hat z_{j-\delta}$"),
         (compensated, "prediction", r"compensated $z^*_j = A^\delta \hat z_{j-\delta}$"),
     ]
@@ -266,7 +267,7 @@ def late_eye_figure(times: np.ndarray, truth: np.ndarray, delayed: np.ndarray,
 #: them.
 DELAY_LINES: dict[str, TrialLine] = {
     "vision": (0, "vision", "vision, delayed  $y_{j-δ}$"),
-    "truth": (0, "truth", "true position"),
+    "truth": (0, "truth", TRUE_POSITION_LABEL),
     "delayed": (0, "estimate", "delayed estimate  $\\hat z_{j-δ}$"),
     "prediction": (0, "prediction", "compensated  $z^*_j = A^δ\\,\\hat z_{j-δ}$"),
     "delayed-error": (1, "estimate", "delayed estimate error"),

@@ -23,6 +23,8 @@ from matplotlib.text import Annotation
 
 from ..plotting import COLORS, DATA_UNDER_LINES, plot_band, style
 from .common import (
+    TRUE_POSITION_LABEL,
+    VISION_READINGS_LABEL,
     TrialLine,
     TrialPanels,
     label_axes,
@@ -114,9 +116,9 @@ def frequency_response_figure(frequency: np.ndarray, curves: Mapping[str, Respon
 
 #: The explorer's lines by gid (see :data:`~lqe_helpers.figures.common.TrialLine`).
 FUSION_LINES: dict[str, TrialLine] = {
-    "vision readings": (0, "vision", "vision readings"),
+    "vision readings": (0, "vision", VISION_READINGS_LABEL),
     "proprioception readings": (0, "proprioception", "proprioception readings"),
-    "truth": (0, "truth", "true position"),
+    "truth": (0, "truth", TRUE_POSITION_LABEL),
     "vision-only": (0, "alternative", "vision-only estimate"),
     "fused": (0, "estimate", "fused estimate"),
     "vision-only error": (1, "alternative", None),

@@ -18,6 +18,9 @@ from matplotlib.ticker import MultipleLocator
 
 from ..plotting import COLORS, DATA_UNDER_LINES, style
 from .common import (
+    BAND_LABEL,
+    ESTIMATE_LABEL,
+    VISION_READINGS_LABEL,
     errorbar_intervals,
     first_seconds,
     label_axes,
@@ -25,6 +28,7 @@ from .common import (
     mark_values,
     plot_series,
 )
+from .common import NOISY_VISION_LABEL as VISION_LABEL  # the explorer's readings
 
 
 def start_up_figure(times: np.ndarray, truth: np.ndarray,
@@ -54,7 +58,7 @@ def start_up_figure(times: np.ndarray, truth: np.ndarray,
     truth = np.asarray(truth, dtype=float)
     fig, (ax_p, ax_v) = plt.subplots(2, 1, figsize=(10, 6.6), sharex=True)
     if readings is not None:
-        plot_series(ax_p, times, [(readings, "vision", "vision readings")], shown)
+        plot_series(ax_p, times, [(readings, "vision", VISION_READINGS_LABEL)], shown)
     for column, ax in enumerate((ax_p, ax_v)):
         plot_series(ax, times, [(truth[:, column], "truth", "truth")]
                     + [(np.asarray(states, dtype=float)[:, column], role, label)
@@ -256,9 +260,6 @@ def p0_sweep_figure(p0_grid: np.ndarray, convergence, start_up, settled, burn_in
 #: Labels of the explorer's artists, so tests and readers can find them. Both panels use
 #: the same labels: axes 0 is position, axes 1 velocity.
 TRUTH_LABEL = "truth"
-VISION_LABEL = "noisy vision"
-ESTIMATE_LABEL = "filtered estimate"
-BAND_LABEL = "±2σ of the filter's own variance"
 
 
 class StartUpPanels(NamedTuple):

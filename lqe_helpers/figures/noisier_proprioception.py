@@ -17,6 +17,8 @@ from matplotlib.ticker import NullLocator
 
 from ..plotting import COLORS, style
 from .common import (
+    TRUE_POSITION_LABEL,
+    VISION_ONLY_LABEL,
     TrialLine,
     TrialPanels,
     interval_arrays,
@@ -128,7 +130,7 @@ def assumed_noise_figure(assumed_sigma_p: np.ndarray, fused, excess, vision_mse:
     fig, (ax, ax_cost) = plt.subplots(1, 2, figsize=(11, 4.4), gridspec_kw={"wspace": 0.28})
     mean_band(ax, assumed_sigma_p, fused, "estimate", "fused, filter assumes σ̃_p",
                marker="o", markersize=4)
-    ax.axhline(vision_mse, **style("alternative", label="vision only"))
+    ax.axhline(vision_mse, **style("alternative", label=VISION_ONLY_LABEL))
     label_axes(ax, ylabel="position MSE (cm²), log scale",
                title="MSE when the filter assumes σ̃_p", yscale="log")
     plain_log_ticks(ax, "y", mse_ticks)
@@ -138,7 +140,7 @@ def assumed_noise_figure(assumed_sigma_p: np.ndarray, fused, excess, vision_mse:
 
     mean_band(ax_cost, assumed_sigma_p, excess, "estimate",
                "fused, filter assumes σ̃_p (paired, 95 % CI band)", marker="o", markersize=4)
-    ax_cost.axhline(vision_excess, **style("alternative", label="vision only"))
+    ax_cost.axhline(vision_excess, **style("alternative", label=VISION_ONLY_LABEL))
     ax_cost.axhline(0, color=COLORS["truth"], linewidth=0.8)
     top = 1.8 * vision_excess
     label_axes(ax_cost, ylabel="extra MSE over the correct model (cm²)",
@@ -159,7 +161,7 @@ THEORY_TITLE = "steady state"
 #: The explorer's lines of the left column by gid
 #: (see :data:`~lqe_helpers.figures.common.TrialLine`).
 NOISIER_LINES: dict[str, TrialLine] = {
-    "truth": (0, "truth", "true position"),
+    "truth": (0, "truth", TRUE_POSITION_LABEL),
     "vision-only": (0, "alternative", "vision-only estimate"),
     "fused": (0, "estimate", "fused estimate (vision + proprioception)"),
     "vision-only error": (1, "alternative", None),
@@ -192,7 +194,7 @@ def noisier_panels(figure: Figure, times: np.ndarray, duration: float, amplitude
     theory = trial.side
     theory.set_title(THEORY_TITLE, fontsize=10)
     theory.axhline(level, **style("alternative", gid="theory vision-only",
-                                  label="vision only"))
+                                  label=VISION_ONLY_LABEL))
     theory.plot(curve_sigma, curve, **style("estimate", gid="theory fused", label="fused"))
     (marker,) = theory.plot([], [], gid="theory now", linestyle="none", marker="o",
                             markersize=7, color=COLORS["estimate"], label="slider's σ_p")

@@ -20,13 +20,17 @@ from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from ..plotting import COLORS, DATA_UNDER_LINES, label_time_position, style
-from .common import TrialLine, label_axes, plot_series, trial_column
+from .common import (
+    BAND_LABEL,
+    ESTIMATE_LABEL,
+    TrialLine,
+    label_axes,
+    plot_series,
+    trial_column,
+)
+from .common import NOISY_VISION_LABEL as VISION_LABEL  # the explorer's readings
+from .common import TRUE_POSITION_LABEL as TRUTH_LABEL  # the explorer's truth line
 
-#: Labels of the explorer's artists, so tests and readers can find them.
-TRUTH_LABEL = "true position"
-VISION_LABEL = "noisy vision"
-ESTIMATE_LABEL = "filtered estimate"
-BAND_LABEL = "±2σ of the filter's own variance"
 #: The explorer's lines by gid (:data:`~lqe_helpers.figures.common.TrialLine`).
 _VISION_LINES: dict[str, TrialLine] = {
     "vision": (0, "vision", VISION_LABEL),
@@ -103,7 +107,7 @@ def estimate_error_figure(times: np.ndarray,
                                                            strict=True):
         band = 2 * np.asarray(std, dtype=float)
         ax.fill_between(times, -band, band, color=COLORS[role], alpha=0.15, linewidth=0,
-                        label="±2σ of the filter's own variance")
+                        label=BAND_LABEL)
         ax.plot(times, np.asarray(error, dtype=float),
                 **style(role, linewidth=1.0, linestyle="-", label="error"))
         ax.plot(times, np.asarray(systematic, dtype=float),
@@ -159,7 +163,7 @@ def lag_figure(times: np.ndarray, truth: np.ndarray,
     fig, axes = plt.subplots(1, len(panels), figsize=(5 * len(panels), 4), sharey=True,
                              squeeze=False)
     for ax, (title, curves) in zip(axes[0], panels.items(), strict=True):
-        series = [(truth, "truth", "true position")]
+        series = [(truth, "truth", TRUTH_LABEL)]
         series += [(values, role, label) for label, (values, role) in curves.items()]
         plot_series(ax, times, series, shown)
         label_axes(ax, "time (s)", title=title, xlim=(start, end),

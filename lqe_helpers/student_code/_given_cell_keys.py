@@ -3,6 +3,7 @@ run python -m lqe_helpers.authoring.given_cells."""
 
 GIVEN: dict[str, tuple[tuple[str, int], ...]] = {
     '00f4ad31e232901e': (('01_vision_only', 19),),
+    '0294ceb4c4256028': (('01_vision_only', 24),),
     '042724c4c6d8e568': (('06_bonus_bias_and_input', 8),),
     '06a8a6791c14709c': (('02_initial_covariance', 21),),
     '083de2243a166a72': (('00_background_model', 6),),
@@ -22,7 +23,6 @@ GIVEN: dict[str, tuple[tuple[str, int], ...]] = {
     '2426772fd0d69193': (('00_background_model', 30),),
     '24368420c0b1d5b8': (('05_sensory_delay', 24),),
     '2516c422e14cc39b': (('04_noisier_proprioception', 12),),
-    '260380c2c5d2be8e': (('01_vision_only', 24),),
     '28e49b8ae2c140ca': (('03_fusion', 6),),
     '30660a83e4dbc7f9': (('03_fusion', 14),),
     '33050355bb87ec92': (('05_sensory_delay', 19),),
@@ -48,7 +48,6 @@ GIVEN: dict[str, tuple[tuple[str, int], ...]] = {
     '57e8c2ad97d7a978': (('05_sensory_delay', 3),),
     '58fd85ca46efcda6': (('03_fusion', 8),),
     '6032f59c671c29d5': (('02_initial_covariance', 12),),
-    '61e4335c7c7af692': (('01_vision_only', 26),),
     '626fad574f52f599': (('01_vision_only', 12),),
     '6384a31414fd8881': (('02_initial_covariance', 10),),
     '64aa00801de66247': (('03_fusion', 10),),
@@ -141,6 +140,7 @@ GIVEN: dict[str, tuple[tuple[str, int], ...]] = {
     'f5dc6551374f958b': (('06_bonus_bias_and_input', 16),),
     'f6a6f6c77edbcc99': (('02_initial_covariance', 8),),
     'f944ef4ef2edca7b': (('03_fusion', 25),),
+    'fc14268fb24cd040': (('01_vision_only', 26),),
     'fc95e556cf218fd9': (('02_initial_covariance', 15),),
     'fca12c8cdec592e5': (('05_sensory_delay', 10),),
     'fcb6f80411ae48f7': (('04_noisier_proprioception', 9),),
