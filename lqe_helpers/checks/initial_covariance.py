@@ -41,7 +41,12 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
-from .paired_mistakes import interval_mistakes, unit_mistakes
+from .paired_mistakes import (
+    OWN_READINGS,
+    TRIAL_READINGS,
+    interval_mistakes,
+    unit_mistakes,
+)
 from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -430,9 +435,11 @@ def check_start_and_after(start_difference: metrics.Interval,
     """
     mses, burn, squared = window_mses(), DEFAULT.burn_in_steps, squared_errors()
     runs = mses["start"].shape[0]
-    against = squared_against_readings()
-    readings_mses = {"start": against[..., :burn].mean(axis=-1),
-                     "after": against[..., burn:].mean(axis=-1)}
+    readings_mses: dict[str, dict] = {window: {} for window in _WINDOWS}
+    for which in (OWN_READINGS, TRIAL_READINGS):   # each run's readings, or the trial's y
+        against = squared_against_readings(which == TRIAL_READINGS)
+        for window, part in (("start", against[..., :burn]), ("after", against[..., burn:])):
+            readings_mses[window][which] = tuple(part.mean(axis=-1).T)
     names = ("diag(1)'s MSE", "diag(1e5)'s MSE")
     cases = (
         ("start_difference", start_difference, "start", "after", {
@@ -473,8 +480,7 @@ def check_start_and_after(start_difference: metrics.Interval,
                            "the task compares the MSEs (cm²)": _paired(np.sqrt(mses_here)),
                            **interval_mistakes(
                                mses_here[:, 0], mses_here[:, 1], *names,
-                               readings=(readings_mses[window][:, 0],
-                                         readings_mses[window][:, 1])),
+                               readings=readings_mses[window]),
                            **unit_mistakes(mses_here[:, 0], mses_here[:, 1], *names),
                        })
     passed(f"start_difference and after_difference match diag(1) − diag(1e5), paired over "
