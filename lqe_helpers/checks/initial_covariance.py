@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .convergence_slips import BAND_FACTOR, OTHER_FACTORS, crossing_times
+from .convergence_slips import BAND_FACTOR, OTHER_FACTORS, crossing_times, wrong_axis_times
 from .judging import (
     CM_PER_M,
     burn_in_slips,
@@ -296,6 +296,7 @@ def _convergence() -> dict[str, object]:
                        "the one trial's readings y": squared_against_readings(True).mean(axis=0)}
     right = metrics.convergence_time(curves, dt)
     per_run = metrics.convergence_time(np.moveaxis(squared, 1, 0), dt)     # (2, runs)
+    axes = wrong_axis_times(squared, dt)
     mistakes = []
     for index in range(len(QUESTION_P0)):
         other = 1 - index
@@ -303,6 +304,7 @@ def _convergence() -> dict[str, object]:
             f"it is the convergence time from P0_{_SMALL_LARGE[other]}, {P0_NAMES[other]}":
                 float(right[other]),
             **crossing_times(curves[index], dt),
+            **axes[index],
             "it is the convergence time of a single run (run 0). The definition applies to "
             "the Monte Carlo mean: average the squared errors over the runs first":
                 float(per_run[index, 0]),
