@@ -331,6 +331,10 @@ def task2(slip: str = ""):
             y = TRUTH + scale * NOISE[:, 0]                         # (n,)
         else:
             y = TRUTH[:, None] + scale * NOISE
+        if slip == "own rng":          # random numbers of the student's own
+            y = TRUTH[:, None] + sigma_v * np.random.default_rng(7).standard_normal(NOISE.shape)
+        if slip == "own normal":
+            y = TRUTH[:, None] + np.random.default_rng(0).normal(0.0, sigma_v, NOISE.shape)
         if slip == "metres":
             y = y / 100
         R = np.array([[{"R = sigma": sigma_v, "R = sigma^4": sigma_v**4,
@@ -375,6 +379,10 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),
     ("engine", "vision_trial runs the pack's own lqe_helpers.experiments.track"),
     ("metres", "vision_trial(1.5) returns (the readings y) is not right: they are in metres"),
+    ("own rng", "the first array vision_trial(1.5) returns (the readings y) has noise of the "
+                "right size, σ_v, but not the given draw: it looks like random numbers of "
+                "your own"),
+    ("own normal", "(the readings y) has noise of the right size, σ_v, but not the given draw"),
 ])
 def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_trial, task2(slip))
