@@ -58,7 +58,9 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     """Check a student's filter ``my_filter(y, A, C, Q, R, z0, P0)`` against Tutorial eq. (5).
 
     The function is called on six small random models (1–4 states, 1–3 sensors, 15
-    steps, from the fixed seed :data:`SEED`), each call given at most
+    steps, from the fixed seed :data:`SEED`) and on the butterfly's whole trial (the
+    tasks' vision-only model on the scenario's readings, all its steps), each call given at
+    most
     :data:`lqe_helpers.student_code.TIME_LIMIT` s, and must return the estimates, an
     array of shape (n, k) whose row j is ẑ after y_j, equal to the pack's engine
     (:func:`lqe_helpers.filter.kalman_filter`, computed before the student's function
@@ -87,8 +89,9 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
         lambda output, m: _filter_output(output, name, m))
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
-        passed(f"{name} matches eq. (5) on {len(models)} random models (1–4 states, 1–3 "
-               f"sensors, {FILTER_STEPS} steps) to {tolerance_text(FUNCTION_RTOL)}, "
+        passed(f"{name} matches eq. (5) on {len(models) - 1} random models (1–4 states, 1–3 "
+               f"sensors, {FILTER_STEPS} steps) and on the butterfly's whole trial "
+               f"({models[-1].n} steps) to {tolerance_text(FUNCTION_RTOL)}, "
                f"{time_limit_text()}")
         return
     mistake = match_mistake(list(FILTER_MISTAKES), filter_models.mistaken_estimates, answers,
@@ -115,6 +118,11 @@ def _explain_wrong_rows(name: str, m: FilterCase, answer: np.ndarray,
     if row == 0:
         where = ("Already the first estimate (after y_0, starting from ẑ = z0 and P = P0) "
                  "differs: check the gain K and the ẑ line of eq. (5)")
+    elif row >= FILTER_STEPS:
+        where = (f"The first {row} estimates are right, then row {row} differs: each line "
+                 f"of eq. (5) works, but something changes after {row} steps. Look for what "
+                 f"depends on the step number or on a fixed count: a loop bound, an array of "
+                 f"a fixed length, a gain or a P kept fixed after a while")
     else:
         first = "The first estimate is" if row == 1 else f"The first {row} estimates are"
         where = (f"{first} right, then row {row} differs: K and ẑ are right at the "
