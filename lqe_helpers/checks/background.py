@@ -271,9 +271,9 @@ def _eyes_closed() -> dict[str, object]:
     g = model.jerk_input_matrix(DEFAULT.dt)
     sigma_j = DEFAULT.process_jerk_std
 
-    def variance(start: np.ndarray, jerk_variance: float) -> np.ndarray:
+    def variance(start: np.ndarray, jerk_variance: float, entry: int = 0) -> np.ndarray:
         Q = jerk_variance * g @ g.T
-        return propagate_covariance(start, DEFAULT.A, Q, EYES_CLOSED_STEPS)[:, 0, 0]
+        return propagate_covariance(start, DEFAULT.A, Q, EYES_CLOSED_STEPS)[:, entry, entry]
 
     right = variance(P_close, sigma_j**2)
     # Every step taken from P_close again instead of from the last P: one step, repeated.
@@ -297,6 +297,10 @@ def _eyes_closed() -> dict[str, object]:
         "feed each step the P the step before returned": 2 * np.sqrt(restarted),
         "sigma is vision's noise σ_v; the random input here is the jerk, of standard "
         "deviation σ_j (sigma_j)": 2 * np.sqrt(variance(P_close, DEFAULT.sigma_v**2)),
+        **{f"it is 2 √P[{entry}, {entry}], the {state}'s variance ({unit}): the position's "
+           f"is the first diagonal entry, P[0, 0] (cm²)":
+               2 * np.sqrt(variance(P_close, sigma_j**2, entry))
+           for entry, state, unit in ((1, "velocity", "cm²/s²"), (2, "acceleration", "cm²/s⁴"))},
     }
     two_sigma = 2 * np.sqrt(right)
     above = int(np.argmax(two_sigma > DEFAULT.amplitude))

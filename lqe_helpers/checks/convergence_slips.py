@@ -1,5 +1,6 @@
 """The slips of a convergence time (notebook 02, Task 2): a curve's band crossed the
-wrong way, a step late, another band; the times they give (s)."""
+wrong way, a step late, another band, the mean over the wrong axis; the times they give
+(s)."""
 
 from __future__ import annotations
 
@@ -40,3 +41,23 @@ def crossing_times(curve: np.ndarray, dt: float) -> dict[str, float]:
 #: (:func:`metrics.convergence_time`'s default), and other bands a student may take.
 BAND_FACTOR = 2.0
 OTHER_FACTORS = (1.5, 3.0, 4.0, 5.0, 10.0)
+
+
+def wrong_axis_times(squared: np.ndarray, dt: float) -> list[dict[str, float]]:
+    """Times (s) of the Monte Carlo mean taken over the wrong axis, one dict per P0.
+
+    ``squared`` are the squared errors (cm²), shape (runs, P0s, n); the task's mean over the
+    runs (axis 0) gives one curve per P0. Over the samples (axis 2) it gives one MSE per run
+    and P0, whose column for a P0 is read as a curve over the runs; over the P0s (axis 1) one
+    curve per run, whose rows 0, 1, … are read as the P0s' curves. Keys name the mistake.
+    """
+    over_samples = squared.mean(axis=2)                       # (runs, P0s)
+    over_p0 = squared.mean(axis=1)                            # (runs, n)
+    ask = ("mean_squared_error is the mean over the runs, axis 0 of squared_error "
+           "(runs, 2, n), one curve over time per P0, shape (2, n)")
+    return [{
+        f"the mean was taken over axis 2, the samples (time), not over the runs: {ask}":
+            float(metrics.convergence_time(over_samples[:, index], dt)),
+        f"the mean was taken over axis 1, the two P0, not over the runs: {ask}":
+            float(metrics.convergence_time(over_p0[index], dt)),
+    } for index in range(squared.shape[1])]

@@ -12,8 +12,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import model
+from .. import experiments, model
 from ..filter import FILTER_ARGS, kalman_filter
+from ..scenario import DEFAULT
 from .machinery import SEED
 from .remembering import remembered
 
@@ -36,6 +37,8 @@ class FilterCase:
     R: np.ndarray
     z0: np.ndarray
     P0: np.ndarray
+    #: What the case is, for the messages; empty for a random model.
+    label: str = ""
 
     @property
     def args(self) -> tuple[np.ndarray, ...]:
@@ -54,6 +57,8 @@ class FilterCase:
         return self.y.shape[0]
 
     def describe(self) -> str:
+        if self.label:
+            return self.label
         return (f"a model with k = {self.k} state{'s' * (self.k != 1)} and m = {self.m} "
                 f"sensor{'s' * (self.m != 1)} (y {self.y.shape}, A {self.A.shape}, "
                 f"C {self.C.shape}, Q {self.Q.shape}, R {self.R.shape}, z0 {self.z0.shape}, "
@@ -69,13 +74,19 @@ class FilterCase:
 #: the butterfly's own model (3 states, vision only); the square (2, 2) model lets a
 #: transposed C run so that it can be recognised.
 FILTER_SIZES = ((3, 1), (2, 2), (1, 1), (4, 3), (3, 2), (2, 1))
-#: Measurements per model.
+#: Measurements per random model.
 FILTER_STEPS = 15
+#: The last case: the butterfly's whole trial (vision alone, the scenario's readings, all
+#: its steps), so a filter that goes wrong only after the random models' few steps (a loop
+#: bound, a gain frozen after a while) is caught here, not blamed in a later notebook.
+TRIAL_LABEL = (f"the butterfly's whole trial (the vision-only model of the tasks, the "
+               f"scenario's {DEFAULT.n_steps} readings)")
 
 
 @remembered
 def models() -> tuple[FilterCase, ...]:
-    """The models of :func:`check_filter`, drawn once from :data:`SEED` (read-only)."""
+    """The models of :func:`check_filter`, drawn once from :data:`SEED` (read-only), then
+    the butterfly's whole trial (:data:`TRIAL_LABEL`)."""
     rng = np.random.default_rng(SEED)
     drawn = []
     for k, m in FILTER_SIZES:
@@ -100,6 +111,13 @@ def models() -> tuple[FilterCase, ...]:
         for array in arrays:
             array.setflags(write=False)
         drawn.append(FilterCase(*arrays))
+    vision = experiments.filter_model(DEFAULT)
+    arrays = [np.array(a, dtype=float) for a in (
+        experiments.track(DEFAULT).measurements, vision.A, vision.C, vision.Q, vision.R,
+        vision.z0, vision.P0)]
+    for array in arrays:
+        array.setflags(write=False)
+    drawn.append(FilterCase(*arrays, label=TRIAL_LABEL))
     return tuple(drawn)
 
 

@@ -39,6 +39,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .readings_slips import monte_carlo_readings_slips, sensor_readings
 from .remembering import remembered
 from .shared_runs import vision_runs
 
@@ -206,16 +207,6 @@ def engine_positions(readings: np.ndarray, sigmas: list[float], column: int = 0,
         readings).estimates[..., column]
 
 
-def sensor_readings(y: np.ndarray) -> dict[str, np.ndarray]:
-    """Each sense's readings (..., n) (cm) of ``y`` (..., n, m), by how a message names them.
-
-    For :func:`~lqe_helpers.checks.judging.mse_mistakes`: an MSE taken against the readings
-    instead of the truth. Shared with :mod:`~lqe_helpers.checks.noisier_proprioception`.
-    """
-    return {f"{sense}'s readings (column {column} of y)": y[..., column]
-            for column, sense in enumerate(FUSED[:y.shape[-1]])}
-
-
 def setup_slips(y: np.ndarray, sigmas: list[float]) -> dict[str, np.ndarray]:
     """Positions (n,) (cm) of the filter on ``y`` (n, m) with a slip in the set-up's inputs.
 
@@ -367,7 +358,7 @@ def monte_carlo_mses() -> dict[str, np.ndarray]:
 
     Keys ``vision`` and ``fused`` (positions), ``<filter>_after`` (after the burn-in),
     ``<filter>_whole``, ``raw`` (vision's readings' MSE), ``<filter>_readings`` (its runs'
-    readings, (runs, n, m), cm). Shared with
+    readings, (runs, n, m), cm), ``y`` (Task 2's one trial, (n, 2), cm). Shared with
     :mod:`~lqe_helpers.checks.fusion_further`.
     """
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
@@ -375,7 +366,8 @@ def monte_carlo_mses() -> dict[str, np.ndarray]:
     fused = experiments.track(DEFAULT, FUSED, runs=runs)
     values = {"vision": vision.positions, "fused": fused.positions,
               "raw": vision.measurement_mse("vision"),
-              "vision_readings": vision.measurements, "fused_readings": fused.measurements}
+              "vision_readings": vision.measurements, "fused_readings": fused.measurements,
+              "y": experiments.readings(DEFAULT, FUSED)}
     for kind in ("vision", "fused"):
         values[f"{kind}_after"] = metrics.mse(values[kind], truth, burn)
         values[f"{kind}_whole"] = metrics.mse(values[kind], truth)
@@ -425,6 +417,9 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
     """
     values = monte_carlo_mses()
     runs, truth, burn = DEFAULT.mc_runs, DEFAULT.truth[:, 0], DEFAULT.burn_in_steps
+    against_readings = monte_carlo_readings_slips(
+        {kind: values[kind] for kind in ("vision", "fused")},
+        {kind: values[f"{kind}_readings"] for kind in ("vision", "fused")}, values["y"], burn)
 
     def per_run(kind: str, other: str, name: str, value: object) -> None:
         label = "vision-only" if kind == "vision" else "fused"
@@ -435,17 +430,15 @@ def check_fusion_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
                   f"MSEs": values[f"{other}_after"],
                   "these are the MSEs of vision's raw readings, not of the filter's "
                   "estimates": values["raw"],
-                  **mse_mistakes(values[kind], truth, burn, DEFAULT.dt,
-                                 readings=sensor_readings(values[f"{kind}_readings"]))})
+                  **mse_mistakes(values[kind], truth, burn, DEFAULT.dt),
+                  **against_readings[kind]})
 
     judge_together(functools.partial(per_run, "vision", "fused", "mse_vision", mse_vision),
                    functools.partial(per_run, "fused", "vision", "mse_fused", mse_fused))
     vision, fused = values["vision_after"], values["fused_after"]
     mistakes = {
         **interval_mistakes(vision, fused, "the vision-only MSE", "the fused MSE",
-                            readings=tuple(
-                                ((values[kind] - values[f"{kind}_readings"][..., 0]) ** 2)
-                                [..., burn:].mean(axis=-1) for kind in ("vision", "fused"))),
+                            readings=against_readings["pairs"]),
         "it is the difference over the whole trial; difference is the one after the first "
         "second (from burn_in on)":
             metrics.mean_ci95(values["vision_whole"] - values["fused_whole"]),

@@ -21,7 +21,7 @@ import numpy as np
 
 from .. import experiments, metrics
 from ..scenario import DEFAULT
-from .convergence_slips import BAND_FACTOR, OTHER_FACTORS, crossing_times
+from .convergence_slips import BAND_FACTOR, OTHER_FACTORS, crossing_times, wrong_axis_times
 from .judging import (
     CM_PER_M,
     burn_in_slips,
@@ -41,7 +41,12 @@ from .machinery import (
     positive_number,
     tolerance_text,
 )
-from .paired_mistakes import interval_mistakes, unit_mistakes
+from .paired_mistakes import (
+    OWN_READINGS,
+    TRIAL_READINGS,
+    interval_mistakes,
+    unit_mistakes,
+)
 from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -291,6 +296,7 @@ def _convergence() -> dict[str, object]:
                        "the one trial's readings y": squared_against_readings(True).mean(axis=0)}
     right = metrics.convergence_time(curves, dt)
     per_run = metrics.convergence_time(np.moveaxis(squared, 1, 0), dt)     # (2, runs)
+    axes = wrong_axis_times(squared, dt)
     mistakes = []
     for index in range(len(QUESTION_P0)):
         other = 1 - index
@@ -298,6 +304,7 @@ def _convergence() -> dict[str, object]:
             f"it is the convergence time from P0_{_SMALL_LARGE[other]}, {P0_NAMES[other]}":
                 float(right[other]),
             **crossing_times(curves[index], dt),
+            **axes[index],
             "it is the convergence time of a single run (run 0). The definition applies to "
             "the Monte Carlo mean: average the squared errors over the runs first":
                 float(per_run[index, 0]),
@@ -430,9 +437,11 @@ def check_start_and_after(start_difference: metrics.Interval,
     """
     mses, burn, squared = window_mses(), DEFAULT.burn_in_steps, squared_errors()
     runs = mses["start"].shape[0]
-    against = squared_against_readings()
-    readings_mses = {"start": against[..., :burn].mean(axis=-1),
-                     "after": against[..., burn:].mean(axis=-1)}
+    readings_mses: dict[str, dict] = {window: {} for window in _WINDOWS}
+    for which in (OWN_READINGS, TRIAL_READINGS):   # each run's readings, or the trial's y
+        against = squared_against_readings(which == TRIAL_READINGS)
+        for window, part in (("start", against[..., :burn]), ("after", against[..., burn:])):
+            readings_mses[window][which] = tuple(part.mean(axis=-1).T)
     names = ("diag(1)'s MSE", "diag(1e5)'s MSE")
     cases = (
         ("start_difference", start_difference, "start", "after", {
@@ -473,8 +482,7 @@ def check_start_and_after(start_difference: metrics.Interval,
                            "the task compares the MSEs (cm²)": _paired(np.sqrt(mses_here)),
                            **interval_mistakes(
                                mses_here[:, 0], mses_here[:, 1], *names,
-                               readings=(readings_mses[window][:, 0],
-                                         readings_mses[window][:, 1])),
+                               readings=readings_mses[window]),
                            **unit_mistakes(mses_here[:, 0], mses_here[:, 1], *names),
                        })
     passed(f"start_difference and after_difference match diag(1) − diag(1e5), paired over "

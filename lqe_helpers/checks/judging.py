@@ -414,10 +414,7 @@ def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
                      f"(the burn-in) must be left out"] = np.mean(error**2, axis=-1)
         for cause, start in burn_in_slips(burn_in_steps, error.shape[-1]).items():
             mistakes[cause] = np.mean(error[..., start:] ** 2, axis=-1)
-        for what, values in (readings or {}).items():
-            mistakes[f"it compares the estimate with {what}, not with the true position: "
-                     f"the MSE measures how far the estimate is from the truth"] = np.mean(
-                (estimate - values)[..., burn_in_steps:] ** 2, axis=-1)
+        mistakes.update(readings_mistakes(estimate, burn_in_steps, readings or {}))
         if dt is not None and burn_in_steps:
             seconds = burn_in_steps * dt
             if float(seconds).is_integer() and int(seconds) != burn_in_steps:
@@ -427,3 +424,18 @@ def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
                                                            axis=-1)
     return {cause: (value if np.all(np.isfinite(value)) else None)
             for cause, value in mistakes.items()}
+
+
+def readings_mistakes(estimate: np.ndarray, burn_in_steps: int,
+                      readings: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """MSEs after the burn-in taken against readings instead of the truth (cm²), shape (...).
+
+    ``estimate`` (..., n) are positions (cm); ``readings`` maps what they are ("vision's
+    readings") to readings (cm) that broadcast with it: each run's own, shape (..., n),
+    or one trial's, shape (n,), the same for every run. Keys name the mistake.
+    """
+    with np.errstate(all="ignore"):
+        return {f"it compares the estimate with {what}, not with the true position: the MSE "
+                f"measures how far the estimate is from the truth":
+                    np.mean((estimate - values)[..., burn_in_steps:] ** 2, axis=-1)
+                for what, values in readings.items()}

@@ -29,7 +29,6 @@ from .fusion import (
     judge_noise_matrix,
     judge_together,
     position_array,
-    sensor_readings,
     setup_slips,
 )
 from .judging import judge, judge_interval, mse_mistakes
@@ -45,6 +44,7 @@ from .machinery import (
     tolerance_text,
 )
 from .paired_mistakes import interval_mistakes, unit_mistakes
+from .readings_slips import monte_carlo_readings_slips, sensor_readings
 from .remembering import remembered
 
 __tracebackhide__ = True  # pytest: leave the checks' frames out of a failure's traceback
@@ -78,6 +78,20 @@ def monte_carlo(sigmas: tuple[float, ...],
     for array in pair:
         array.flags.writeable = False
     return pair
+
+
+@remembered
+def readings_slips() -> dict[str, dict]:
+    """Task 3's per-run MSEs taken against readings instead of the truth (cm², (runs,)):
+    :func:`~lqe_helpers.checks.readings_slips.monte_carlo_readings_slips` of the
+    question's runs, with Task 2's one trial y."""
+    senses = {"vision": (SIGMA_V,), "fused": (SIGMA_V, SIGMA_P)}
+    runs = {kind: experiments.track(DEFAULT, FUSED[:len(sigmas)], sigmas=list(sigmas),
+                                    runs=DEFAULT.mc_runs) for kind, sigmas in senses.items()}
+    y = experiments.readings(DEFAULT, FUSED, sigmas=list(senses["fused"]))
+    return monte_carlo_readings_slips({kind: run.positions for kind, run in runs.items()},
+                                      {kind: run.measurements for kind, run in runs.items()},
+                                      y, BURN)
 
 
 def paired(first: np.ndarray, second: np.ndarray) -> metrics.Interval:
@@ -306,9 +320,12 @@ def check_noisier_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
             both_squared,
     }
 
+    against_readings = readings_slips()
+
     def per_run(name: str, right: tuple[np.ndarray, np.ndarray],
                 other: tuple[np.ndarray, np.ndarray], other_name: str,
-                wrong: dict[str, tuple[np.ndarray, np.ndarray]], value: object) -> None:
+                wrong: dict[str, tuple[np.ndarray, np.ndarray]], kind: str,
+                value: object) -> None:
         array = argument_array(value, name, f"one MSE per run (cm²), an array of shape "
                                             f"({runs},)")
         if array.size == 1:
@@ -319,14 +336,17 @@ def check_noisier_difference(mse_vision: np.ndarray, mse_fused: np.ndarray,
               mistakes={f"these are the {other_name} filter's MSEs": other[0],
                         "these are over the whole trial; the MSEs leave out the first second "
                         "(the start-up)": right[1],
-                        **{cause: pair[0] for cause, pair in wrong.items()}})
+                        **{cause: pair[0] for cause, pair in wrong.items()},
+                        **against_readings[kind]})
 
-    judge_together(partial(per_run, "mse_vision", vision, fused, "fused", {}, mse_vision),
+    judge_together(partial(per_run, "mse_vision", vision, fused, "fused", {}, "vision",
+                           mse_vision),
                    partial(per_run, "mse_fused", fused, vision, "vision-only", sigma_causes,
-                           mse_fused))
+                           "fused", mse_fused))
     first, second = vision[0], fused[0]
     mistakes = {
-        **interval_mistakes(first, second, "the vision-only MSE", "the fused MSE"),
+        **interval_mistakes(first, second, "the vision-only MSE", "the fused MSE",
+                            readings=against_readings["pairs"]),
         "it is the difference over the whole trial; difference is the one after the first "
         "second": paired(vision[1], fused[1]),
         **{cause: paired(first, pair[0]) for cause, pair in sigma_causes.items()},

@@ -302,8 +302,10 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
         return ("the task cell above is not written yet: replace its line `raise "
                 "NotImplementedError` with your code, run that cell, then this check again")
     if not run.completed:
-        return (f"the task cell above stopped with an error: {RERUN} (it judges what that "
-                f"cell makes, not the values of an earlier run)")
+        stopped = ("ran a cell of its own (get_ipython().run_cell) that stopped with an error"
+                   if run.inner_failed else "stopped with an error")
+        return (f"the task cell above {stopped}: {RERUN} (it judges what that cell makes, not "
+                f"the values of an earlier run)")
     problem = trail_problem(check, run)
     if problem is not None:
         return problem

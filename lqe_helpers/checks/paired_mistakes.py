@@ -4,10 +4,19 @@ pairing, the interval's arithmetic, either condition alone, the readings for the
 
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 import numpy as np
 
 from .. import metrics
 from .judging import NORMAL_95
+
+#: How :func:`interval_mistakes` names the readings of ``readings``: each run's own, or
+#: those of the one trial of a task's earlier part (y), broadcast over every run.
+OWN_READINGS = "the readings"
+TRIAL_READINGS = "the readings of one trial (y), the same for every run"
+_TRUTH = ("an estimate's error is estimate − true position (the truth), not estimate − "
+          "reading")
 
 
 def _around(mean: float, half: float, runs: int) -> metrics.Interval:
@@ -16,7 +25,7 @@ def _around(mean: float, half: float, runs: int) -> metrics.Interval:
 
 def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
                       second_name: str, *,
-                      readings: tuple[np.ndarray, np.ndarray] | None = None,
+                      readings: Mapping[str, tuple[np.ndarray, np.ndarray]] | None = None,
                       ) -> dict[str, metrics.Interval]:
     """The usual mistakes of a paired difference ``first − second`` with its 95 % interval.
 
@@ -26,8 +35,10 @@ def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
         Per-run values of the two conditions, run r of both on the same noise.
     first_name, second_name : str
         What they are, for the messages ("the raw readings' MSE").
-    readings : (ndarray, ndarray), optional
-        The same per-run MSEs measured against the readings instead of the truth.
+    readings : mapping of str to (ndarray, ndarray), optional
+        The same per-run MSEs measured against readings instead of the truth, by which
+        readings: each run's own (:data:`OWN_READINGS`) or one trial's y, the same for
+        every run (:data:`TRIAL_READINGS`).
 
     Returns
     -------
@@ -69,13 +80,12 @@ def interval_mistakes(first: np.ndarray, second: np.ndarray, first_name: str,
         f"{both}": alone_first,
         f"it is the interval of {second_name} alone, not of the per-run differences "
         f"{both}": alone_second,
-        **({} if readings is None else {
-            "the MSEs are measured against the readings: an estimate's error is estimate − "
-            "true position (the truth), not estimate − reading":
-                metrics.mean_ci95(readings[0] - readings[1]),
-            f"{first_name} is measured against the readings: an estimate's error is "
-            f"estimate − true position (the truth), not estimate − reading":
-                metrics.mean_ci95(readings[0] - second)}),
+        **{cause: interval for which, pair in (readings or {}).items()
+           for cause, interval in {
+               f"the MSEs are measured against {which}: {_TRUTH}":
+                   metrics.mean_ci95(pair[0] - pair[1]),
+               f"{first_name} is measured against {which}: {_TRUTH}":
+                   metrics.mean_ci95(pair[0] - second)}.items()},
     }
 
 

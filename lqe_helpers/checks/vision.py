@@ -58,7 +58,9 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
     """Check a student's filter ``my_filter(y, A, C, Q, R, z0, P0)`` against Tutorial eq. (5).
 
     The function is called on six small random models (1–4 states, 1–3 sensors, 15
-    steps, from the fixed seed :data:`SEED`), each call given at most
+    steps, from the fixed seed :data:`SEED`) and on the butterfly's whole trial (the
+    tasks' vision-only model on the scenario's readings, all its steps), each call given at
+    most
     :data:`lqe_helpers.student_code.TIME_LIMIT` s, and must return the estimates, an
     array of shape (n, k) whose row j is ẑ after y_j, equal to the pack's engine
     (:func:`lqe_helpers.filter.kalman_filter`, computed before the student's function
@@ -87,8 +89,9 @@ def check_filter(my_filter: Callable[..., np.ndarray]) -> None:
         lambda output, m: _filter_output(output, name, m))
     wrong = [i for i in answers if not close(answers[i], correct[i], FUNCTION_RTOL)]
     if not wrong and not errors:
-        passed(f"{name} matches eq. (5) on {len(models)} random models (1–4 states, 1–3 "
-               f"sensors, {FILTER_STEPS} steps) to {tolerance_text(FUNCTION_RTOL)}, "
+        passed(f"{name} matches eq. (5) on {len(models) - 1} random models (1–4 states, 1–3 "
+               f"sensors, {FILTER_STEPS} steps) and on the butterfly's whole trial "
+               f"({models[-1].n} steps) to {tolerance_text(FUNCTION_RTOL)}, "
                f"{time_limit_text()}")
         return
     mistake = match_mistake(list(FILTER_MISTAKES), filter_models.mistaken_estimates, answers,
@@ -115,6 +118,11 @@ def _explain_wrong_rows(name: str, m: FilterCase, answer: np.ndarray,
     if row == 0:
         where = ("Already the first estimate (after y_0, starting from ẑ = z0 and P = P0) "
                  "differs: check the gain K and the ẑ line of eq. (5)")
+    elif row >= FILTER_STEPS:
+        where = (f"The first {row} estimates are right, then row {row} differs: each line "
+                 f"of eq. (5) works, but something changes after {row} steps. Look for what "
+                 f"depends on the step number or on a fixed count: a loop bound, an array of "
+                 f"a fixed length, a gain or a P kept fixed after a while")
     else:
         first = "The first estimate is" if row == 1 else f"The first {row} estimates are"
         where = (f"{first} right, then row {row} differs: K and ẑ are right at the "
@@ -265,6 +273,23 @@ def _trial(sigma_v: float) -> dict[str, object]:
     }
 
 
+#: Readings whose noise (y − truth) / σ_v has a spread within 1 ± the first, a mean within
+#: ± the second and a correlation with the given draw within ± the third are "noise of the
+#: right size, another draw". Measured on 20 000 draws of 1000 unit normal samples: spread
+#: within 1 ± 0.095, mean within ± 0.147, correlation of two draws within ± 0.124.
+_OWN_NOISE_SPREAD, _OWN_NOISE_MEAN, _OWN_NOISE_CORRELATION = 0.15, 0.2, 0.3
+
+
+def _own_noise(y: np.ndarray, sigma_v: float) -> bool:
+    """Whether readings ``y`` (n, 1) (cm) are the truth plus noise of spread σ_v that is
+    not the scenario's draw (the student's own random numbers)."""
+    given = DEFAULT.unit_noise(sensors=("vision",))[:, 0]
+    scaled = (y[:, 0] - DEFAULT.truth[:, 0]) / sigma_v
+    return bool(abs(float(np.std(scaled)) - 1.0) <= _OWN_NOISE_SPREAD
+                and abs(float(np.mean(scaled))) <= _OWN_NOISE_MEAN
+                and abs(float(np.corrcoef(scaled, given)[0, 1])) <= _OWN_NOISE_CORRELATION)
+
+
 def _trial_output(output: object, name: str, sigma_v: float) -> tuple[object, object]:
     """The two values ``vision_trial`` returned, or CheckFailed saying what came back."""
     if isinstance(output, (tuple, list)) and len(output) == 2:
@@ -320,6 +345,13 @@ def check_vision_trial(vision_trial: Callable[[float], tuple[np.ndarray, np.ndar
         if y.shape == (n,):
             raise CheckFailed(f"{label} is flat, shape ({n},); keep one column per sensor, "
                               f"shape ({n}, 1), as my_filter reads one row per time step")
+        if y.shape == (n, 1) and not close(y, right["y"], FUNCTION_RTOL) and \
+                _own_noise(y, sigma):
+            raise CheckFailed(
+                f"{label} has noise of the right size, σ_v, but not the given draw: it "
+                f"looks like random numbers of your own. Make the readings from the set-up "
+                f"cell's noise (the scenario's seeded draw), truth[:, None] + σ_v · noise, so "
+                f"that every task and check works on the same trial")
         judge(label, y, right["y"], FUNCTION_RTOL, unit="cm", mistakes=right["y_mistakes"],
               what="truth + σ_v · noise on the scenario's draw")
         label = f"the second array {name}({sigma:g}) returns (the estimates)"

@@ -8,8 +8,11 @@ for every cell (a student may write a task's answer in a cell of their own, with
 ``# Task:`` comment) and sets a profile hook
 (``sys.setprofile``, chained to any hook already set) that notes every function of the
 ``lqe_helpers`` package the cell runs, at any depth; ``post_run_cell`` ends it, noting
-whether the cell completed. A function loaded with :func:`~lqe_helpers.student_code.load`
-records its calls (inputs and output) into the task cell running it (:func:`note_call`).
+whether the cell completed. A cell that the running cell runs itself
+(``get_ipython().run_cell(...)``) is part of it: its events neither end that run nor start
+one, its code's names count as the outer cell's, and its error as the outer cell's. A
+function loaded with :func:`~lqe_helpers.student_code.load` records its calls (inputs and
+output) into the task cell running it (:func:`note_call`).
 
 A check finds its task cell with :func:`run_for`: the latest run of a cell that defines
 (assigns or defs at its top level) one of the names the check cell passes it, or of a
@@ -97,7 +100,10 @@ class TaskRun:
     reads : frozenset of str
         Names its code reads before it gives them a value (:func:`read_names`).
     completed : bool or None
-        Whether it ran to its end without an error; None while it runs.
+        Whether it ran to its end without an error, and so did every cell it ran itself
+        (``get_ipython().run_cell(...)``, whose code counts as its own); None while it runs.
+    inner_failed : bool
+        Whether a cell it ran itself stopped with an error (then ``completed`` is False).
     not_written : bool
         Whether it stopped with ``NotImplementedError`` (a student edition's stub).
     pack_calls : dict
@@ -128,6 +134,7 @@ class TaskRun:
     given: bool = False
     reads: frozenset[str] = frozenset()
     completed: bool | None = None
+    inner_failed: bool = False
     not_written: bool = False
     pack_calls: dict[types.CodeType, str] = field(default_factory=dict)
     entries: dict[str, str] = field(default_factory=dict)
@@ -157,11 +164,20 @@ class _Record:
         self.noting: Callable | None = None   # the running cell's profile hook
         self.listening: contextlib.ExitStack | None = None
         self.shells: set[int] = set()
+        # The cells running now, outermost first: a cell may run another
+        # (get_ipython().run_cell(...)), whose events come inside its own. Each is the
+        # event's info (IPython's ExecutionInfo, which its result carries back) and code.
+        self.open: list[tuple[object, str]] = []
+        self.inner_error: BaseException | bool | None = None  # a nested cell's failure
 
     def pre_run_cell(self, info: object) -> None:
         source = getattr(info, "raw_cell", "") or ""
         self.cell = source
+        if self.current is not None and self.open:  # run by the cell running now: part of it
+            self._nest(info, source)
+            return
         self._stop()
+        self.open, self.inner_error = [(info, source)], None
         number = self.runs[-1].number + 1 if self.runs else 1
         run = TaskRun(number=number, source=source, defines=defined_names(source),
                       mentions=mentioned_names(source), task=is_task_cell(source),
@@ -225,12 +241,36 @@ class _Record:
         self.listening = contextlib.ExitStack()
         self.listening.enter_context(listening_outside(outside))
 
+    def _nest(self, info: object, source: str) -> None:
+        """A cell run by the cell running now: its code counts as the outer cell's."""
+        run = self.current
+        assert run is not None
+        run.reads = run.reads | (read_names(source) - run.defines)
+        run.defines = run.defines | defined_names(source)
+        self.open.append((info, source))
+
     def post_run_cell(self, result: object) -> None:
+        success = bool(getattr(result, "success", False))
+        error = getattr(result, "error_in_exec", None)
+        info = getattr(result, "info", None)
+        nested = len(self.open) > 1
+        if self.open and info is not None and info is not self.open[-1][0]:
+            nested = True  # a cell run inside stopped before it started (no pre_run_cell)
+        elif nested:
+            self.open.pop()
+            self.cell = self.open[-1][1]
+        if nested:  # the cell that ran it goes on; its failure is that cell's
+            if not success and self.inner_error is None:
+                self.inner_error = error if error is not None else True
+            return
+        self.open = []
         run = self._stop()
         if run is not None:
-            run.completed = bool(getattr(result, "success", False))
-            run.not_written = isinstance(getattr(result, "error_in_exec", None),
-                                         NotImplementedError)
+            run.completed = success and self.inner_error is None
+            run.inner_failed = self.inner_error is not None
+            run.not_written = any(isinstance(failure, NotImplementedError)
+                                  for failure in (error, self.inner_error))
+        self.inner_error = None
 
     def _stop(self) -> TaskRun | None:
         run, self.current = self.current, None

@@ -167,13 +167,14 @@ def eyes_closed(*, mistake=""):
              "sigma_v": DEFAULT.sigma_v}.get(mistake, DEFAULT.process_jerk_std)
     A, g = model.transition_matrix(DEFAULT.dt), model.jerk_input_matrix(DEFAULT.dt)
     P_close = P
-    variances = [P[0, 0]]
+    entry = 1 if mistake == "velocity entry" else 0   # P[1, 1] for the position's P[0, 0]
+    variances = [P[entry, entry]]
     for _ in range(100):
         if mistake == "restart":  # each step from P_close, not from the last P
             P = predict_covariance(P_close, A, g, sigma)
         else:
             P = predict_covariance(P, A, g, sigma)
-        variances.append(P[0, 0])
+        variances.append(P[entry, entry])
     variances = np.array(variances)
     two_sigma = {"one sigma": np.sqrt(variances), "no root": 2 * variances,
                  "no start": 2 * np.sqrt(variances[1:])}.get(mistake, 2 * np.sqrt(variances))
@@ -212,6 +213,8 @@ def test_check_eyes_closed_without_crossing_judges_the_band_only(capsys):
     ("trial time", "it counts from the start of the trial"),
     ("variance crossing", "it is when the variance P[0, 0] (cm²) exceeds the amplitude"),
     ("sigma crossing", "it is when σ exceeds the amplitude"),
+    ("velocity entry", "two_sigma is not right: it is 2 √P[1, 1], the velocity's variance "
+                       "(cm²/s²): the position's is the first diagonal entry, P[0, 0] (cm²)"),
 ])
 def test_check_eyes_closed_names_each_realistic_mistake(mistake, phrase):
     assert_fails(phrase, checks.check_eyes_closed, predict_covariance,

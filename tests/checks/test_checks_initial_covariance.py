@@ -191,6 +191,21 @@ def test_check_convergence_times_names_the_slips_made_for_both(squared) -> None:
     assert "mean absolute error" in message and "the band is 3 ×" in message
 
 
+@pytest.mark.parametrize(("axis", "phrase"), [
+    (2, "the mean was taken over axis 2, the samples (time), not over the runs"),
+    (1, "the mean was taken over axis 1, the two P0, not over the runs")])
+def test_check_convergence_times_names_the_mean_over_the_wrong_axis(squared, axis,
+                                                                    phrase) -> None:
+    """squared_error.mean(axis=2) got a guess between two other causes, .mean(axis=1) the
+    wrong cause "a single run" (issue 23)."""
+    mean_squared_error = squared.mean(axis=axis)     # (runs, 2) or (runs, n)
+    curves = mean_squared_error.T if axis == 2 else mean_squared_error[:2]
+    wrong = [hand_convergence_time(curve, DT) for curve in curves]
+    message = assert_fails(f"t_small = {wrong[0]:g} s and t_large = {wrong[1]:g} s are not "
+                           f"right: {phrase}", checks.check_convergence_times, *wrong)
+    assert "one of these" not in message and "single run" not in message
+
+
 def test_check_convergence_times_names_each_typical_mistake(batch, squared, times) -> None:
     t_small, t_large = times
     curve = squared[:, 0].mean(axis=0)

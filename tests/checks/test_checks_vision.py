@@ -8,6 +8,7 @@ them. The worked filter is the test oracle ``reference_loops`` (outside the pack
 from __future__ import annotations
 
 import sys
+import time
 
 import numpy as np
 import pytest
@@ -81,7 +82,40 @@ def student_filter(y, A, C, Q, R, z0, P0, *, mistake: str = ""):
 def test_check_filter_passes_the_worked_solution(capsys) -> None:
     line = assert_passes(capsys, checks.check_filter, student_filter)
     assert line == ("✓ student_filter matches eq. (5) on 6 random models (1–4 states, 1–3 "
-                    "sensors, 15 steps) to 1e-9, each call given at most 5 s")
+                    "sensors, 15 steps) and on the butterfly's whole trial (1000 steps) to "
+                    "1e-9, each call given at most 5 s")
+
+
+@pytest.mark.parametrize("late", [15, 50, 100])
+def test_check_filter_catches_a_filter_that_goes_wrong_after_the_random_models_steps(
+        late: int) -> None:
+    """issue 23: the check ran 15 steps only, so a filter wrong from step 15 on (here: the
+    gain frozen, "it has settled") passed 01 and notebooks 02–05 blamed it later. (Frozen
+    after about 200 steps, the gain has settled to 1e-9 and the filter is right.)"""
+    def my_filter(y, A, C, Q, R, z0, P0):
+        z, P, rows = np.asarray(z0, dtype=float), P0, []
+        for j, y_j in enumerate(y):
+            if j < late:
+                K = P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+            z = A @ z + K @ (y_j - C @ A @ z)
+            P = A @ (P - K @ C @ P) @ A.T + Q
+            rows.append(z.copy())
+        return np.array(rows)
+
+    message = assert_fails(f"my_filter does not match eq. (5) on the butterfly's whole trial "
+                           f"(the vision-only model of the tasks, the scenario's 1000 "
+                           f"readings). The first {late} estimates are right, then row {late} "
+                           f"differs", checks.check_filter, my_filter)
+    assert "something changes after" in message and "third line" not in message
+
+
+def test_check_filter_answers_well_under_a_second(capsys) -> None:
+    """The butterfly's whole trial (1000 steps) keeps the check quick: measured 0.17 s a
+    call (0.03 s with the random models alone), 0.25 s the first time."""
+    checks.check_filter(student_filter)                 # the engine's answers, once
+    start = time.perf_counter()
+    checks.check_filter(student_filter)
+    assert time.perf_counter() - start < 1.0
 
 
 def test_check_filter_passes_a_student_filter_with_inv(capsys) -> None:
@@ -331,6 +365,10 @@ def task2(slip: str = ""):
             y = TRUTH + scale * NOISE[:, 0]                         # (n,)
         else:
             y = TRUTH[:, None] + scale * NOISE
+        if slip == "own rng":          # random numbers of the student's own
+            y = TRUTH[:, None] + sigma_v * np.random.default_rng(7).standard_normal(NOISE.shape)
+        if slip == "own normal":
+            y = TRUTH[:, None] + np.random.default_rng(0).normal(0.0, sigma_v, NOISE.shape)
         if slip == "metres":
             y = y / 100
         R = np.array([[{"R = sigma": sigma_v, "R = sigma^4": sigma_v**4,
@@ -375,6 +413,10 @@ def test_check_vision_trial_passes_the_worked_answer(capsys) -> None:
     ("no return", "got None (nothing): does it end with `return y, estimates`?"),
     ("engine", "vision_trial runs the pack's own lqe_helpers.experiments.track"),
     ("metres", "vision_trial(1.5) returns (the readings y) is not right: they are in metres"),
+    ("own rng", "the first array vision_trial(1.5) returns (the readings y) has noise of the "
+                "right size, σ_v, but not the given draw: it looks like random numbers of "
+                "your own"),
+    ("own normal", "(the readings y) has noise of the right size, σ_v, but not the given draw"),
 ])
 def test_check_vision_trial_names_the_cause_of_wrong_science(slip: str, phrase: str) -> None:
     assert_fails(phrase, checks.check_vision_trial, task2(slip))
