@@ -63,10 +63,20 @@ def pytest_configure(config: pytest.Config) -> None:
 
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
-    """nbval's notebook cells are marked ``kernel``."""
+    """nbval's notebook cells are marked ``kernel``; the work units of :data:`FIRST` run
+    first, in its order (see there)."""
     for item in items:
         if item.path.suffix == ".ipynb":
             item.add_marker(pytest.mark.kernel)
+    items.sort(key=lambda item: FIRST.get(work_unit(item.nodeid), len(FIRST)))
+
+
+#: The work units (:func:`work_unit`) that start a run, in this order; the rest follow in
+#: file order. pytest-xdist gives each of two workers one unit, then a second: the longest
+#: (grading, the JupyterLab group) start at once, and the handout pages go to the worker
+#: that builds the handouts (tests/artefacts.py), after it, instead of waiting for them.
+FIRST = {"tests/grading/test_grading_pipeline.py": 0, "tests/authoring/test_handouts.py": 1,
+         "jupyterlab": 2, "handout pages": 3}
 
 
 #: Test files (relative to the top folder) that share a costly resource of their pytest

@@ -890,8 +890,10 @@ def test_the_packs_answer_made_out_of_the_records_sight_fails(how, folder):
 
 
 def test_a_task_cell_that_loses_the_records_hook_is_refused(folder):
-    """Python switches a profile hook off when it raises (a RecursionError inside it), with
-    no audit event: a cell whose hook is gone at its end says so, and its check refuses."""
+    """Python switches a profile hook off when it raises (a RecursionError inside it); its
+    ``sys.setprofile`` event may be one the watch does not blame on the student (here, heard
+    with the watch set aside: ``outside.unheard``). A cell whose hook is gone at its end says
+    so all the same, and its check refuses."""
     runner = CellRunner()
     try:
         lose = ("from lqe_helpers.student_code import outside\nimport sys\n"
