@@ -72,17 +72,17 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
 
 
 #: The work units (:func:`work_unit`) that start a run, in this order; the rest follow in
-#: file order. pytest-xdist gives each of two workers one unit, then a second: the longest
-#: (grading, the JupyterLab group) start at once, and the handout pages go to the worker
-#: that builds the handouts (tests/artefacts.py), after it, instead of waiting for them.
-FIRST = {"tests/grading/test_grading_pipeline.py": 0, "tests/authoring/test_handouts.py": 1,
-         "jupyterlab": 2, "handout pages": 3}
+#: file order. The longest start at once, one on each worker: the handout pages (the
+#: handouts built, then every page read in Chromium, in one worker: none waits for the
+#: build), the grading pipeline, then the JupyterLab group.
+FIRST = {"handout pages": 0, "tests/grading/test_grading_pipeline.py": 1, "jupyterlab": 2}
 
 
 #: Test files (relative to the top folder) that share a costly resource of their pytest
-#: session, so pytest-xdist runs each group in one worker: one Chromium for every
-#: handout page; one JupyterLab server.
+#: session, so pytest-xdist runs each group in one worker: the handouts' build and one
+#: Chromium for every handout page; one JupyterLab server.
 WORKER_GROUPS = {
+    "tests/authoring/test_handouts.py": "handout pages",  # builds them (tests/artefacts.py)
     "tests/browser/test_handouts_a11y.py": "handout pages",
     "tests/browser/test_handouts_offline.py": "handout pages",
     "tests/browser/test_harness.py": "jupyterlab",
