@@ -5,7 +5,7 @@ A check must judge what the current task cell produced. In IPython, :func:`watch
 (called by :func:`~lqe_helpers.student_code.brief_errors`, which every notebook's set-up
 cell runs) registers two of IPython's events: ``pre_run_cell`` starts a :class:`TaskRun`
 for every cell (a student may write a task's answer in a cell of their own, without the
-``# Task:`` comment) and sets a profile hook
+``# Task:`` comment) and, unless the pack gives the cell, sets a profile hook
 (``sys.setprofile``, chained to any hook already set) that notes every function of the
 ``lqe_helpers`` package the cell runs, at any depth; ``post_run_cell`` ends it, noting
 whether the cell completed. A cell that the running cell runs itself
@@ -22,7 +22,8 @@ whose comment names one; else the latest task cell run. :func:`ancestry` follows
 run's values back through the cells the student wrote: a value made by the pack's solution
 in an earlier cell of theirs and copied into the task cell is theirs no more than if the
 task cell had called the pack itself. The cells the pack gives
-(:mod:`~lqe_helpers.student_code.given_cells`) end that trail. Outside IPython,
+(:mod:`~lqe_helpers.student_code.given_cells`) before the task end that trail; one from
+further on, run early, is on it (its values are not the student's). Outside IPython,
 or before the set-up cell ran, there is no record and :func:`run_for` returns None: the
 checks then behave as without it.
 """
