@@ -168,6 +168,26 @@ class InputTracking:
                                             self.bias_stds, self.bias, runs.bias_rms_error(),
                                             runs.bias_stds[0])
 
+    def signal_figure(self) -> Figure:
+        """Notebook 06's Figure 3: this run's acceleration signal beside a and a + b.
+
+        Built by :func:`lqe_helpers.figures.acceleration_signal_figure` from this run's
+        readings, the scenario's true mean acceleration per step
+        (:func:`~lqe_helpers.bias_model.equations.step_accelerations`) and the true bias.
+
+        Raises
+        ------
+        ValueError
+            If this tracking is not a single run.
+        """
+        from .. import figures
+
+        if self.readings.ndim != 1:
+            raise ValueError(f"signal_figure draws a single run: this tracking has leading "
+                             f"axes {self.readings.shape[:-1]}")
+        return figures.acceleration_signal_figure(self.scenario.times, self.readings,
+                                                  step_accelerations(self.scenario), self.bias)
+
     def dead_reckoning_mse(self) -> np.ndarray:
         """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
         return metrics.mse(self.dead_reckoning[..., 0], self.truth[:, 0],

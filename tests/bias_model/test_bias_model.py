@@ -427,3 +427,26 @@ def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
     for wrong_run, runs in ((mc, mc), (run, run), (run, other), (run, "mc")):
         with pytest.raises(ValueError, match=r"single run|runs must be"):
             wrong_run.learning_figure(runs)
+
+
+def test_signal_figure_is_notebook_06s_figure_3_from_one_result() -> None:
+    """``run.signal_figure()`` draws what the run's readings, a and b drew, pixel for pixel;
+    another run (another σ_a) draws another figure."""
+    import matplotlib.pyplot as plt
+
+    from lqe_helpers import figures, plotting
+
+    run = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS)
+    by_arrays = figures.acceleration_signal_figure(
+        DEFAULT.times, run.readings, bias_model.step_accelerations(DEFAULT), DEFAULT_BIAS)
+    by_object = run.signal_figure()
+    noisier = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS, sigma_a=400.0)
+    other = noisier.signal_figure()
+    try:
+        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
+        assert plotting.figure_png(other) != plotting.figure_png(by_arrays)
+    finally:
+        for fig in (by_arrays, by_object, other):
+            plt.close(fig)
+    with pytest.raises(ValueError, match="single run"):
+        bias_model.track_with_input(DEFAULT, runs=2).signal_figure()
