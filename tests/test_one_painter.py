@@ -175,6 +175,9 @@ def _draw_result_figure(method: str) -> plt.Figure:
             (sweep.positions - truth).mean(axis=0) ** 2, (0.3, 0.5), 0.1, labels),
         "InputTracking.signal_figure": lambda: bias_model.track_with_input(
             DEFAULT).signal_figure(),
+        "InputTracking.settling_figure": lambda: bias_model.InputTracking.settling_figure(
+            {20.0: bias_model.track_with_input(DEFAULT, runs=2)},
+            {1.5: bias_model.track_with_input(DEFAULT, sigma_v=1.5, runs=2)}),
         "Tracking.figure": lambda: experiments.track(DEFAULT).figure(),
         "Tracking.error_figure": lambda: experiments.track(
             DEFAULT, sigmas=[[1.5], [4.5]], runs=2).error_figure(clean),
@@ -203,6 +206,7 @@ def test_the_table_names_the_result_methods_of_notebooks_00_02_and_06() -> None:
     assert table["Tracking.gains_figure"] == "gains_figure"
     assert table["Tracking.belief_figure"] == "belief_and_error_figure"
     assert table["InputTracking.signal_figure"] == "acceleration_signal_figure"
+    assert table["InputTracking.settling_figure"] == "bias_settling_figure"
 
 
 @pytest.mark.slow
