@@ -64,13 +64,18 @@ class TrackingFigures:
         ------
         ValueError
             If this is not a run of vision alone, ``run`` does not pick one run,
-            ``prediction`` is not an OpenLoop, ``close`` is not a sample of the trial, or
-            ``prediction_std`` is not finite of shape (h,).
+            ``prediction`` is not an OpenLoop from this run's estimate at ``close``,
+            ``close`` is not a sample of the trial, or ``prediction_std`` is not finite of
+            shape (h,).
         """
         readings, positions = self._vision_run(run)
         validation.instance("prediction", prediction, OpenLoop, "from prediction.open_loop()")
         times = self.scenario.times
         close = validation.count("close", close, 0, times.size - 1)
+        start = validation.one_run(self.result.estimates, run, trailing=2)[close]
+        if not np.allclose(prediction.means[0], start, rtol=0, atol=1e-9):
+            raise ValueError(f"prediction must start from this run's estimate at sample close "
+                             f"= {close}, {start}, got {prediction.means[0]}")
         std = validation.shaped_array("prediction_std", prediction_std, prediction.times.shape,
                                       "σ (cm) at each time of the prediction")
         from . import figures
@@ -113,8 +118,9 @@ class TrackingFigures:
                     and np.array_equal(other._vision_run(run)[0], readings))
 
         if not panels or not all(of_these_readings(other) for other in panels.values()):
+            got = {title: type(other).__name__ for title, other in panels.items()}
             raise ValueError("panels must map titles to Trackings of this run's readings and "
-                             f"true path (at least one), got {len(panels)} entries")
+                             f"true path (at least one), got {got or 'none'}")
         estimates = {title: other._vision_run(run)[1] for title, other in panels.items()}
         from . import figures
 

@@ -44,7 +44,7 @@ def test_open_loop_figure_is_the_painters_figure_of_the_runs_arrays() -> None:
         DEFAULT.times[CLOSE], DEFAULT.times[CLOSE] + blind.times, blind.means[:, 0], std)
     assert same_png(tracking.open_loop_figure(blind, CLOSE, std), by_arrays)
     other = experiments.track(DEFAULT, sigmas=[4.5])
-    assert not same_png(other.open_loop_figure(blind, CLOSE, std),
+    assert not same_png(other.open_loop_figure(_eyes_closed(other)[0], CLOSE, std),
                         tracking.open_loop_figure(blind, CLOSE, std))
 
 
@@ -109,6 +109,9 @@ def test_belief_figure_is_the_painters_figure_of_the_runs_arrays() -> None:
      "prediction must be"),
     (lambda: experiments.track(DEFAULT).open_loop_figure(
         _eyes_closed(experiments.track(DEFAULT))[0], DEFAULT.n_steps, np.ones(101)), "close"),
+    (lambda: experiments.track(DEFAULT).open_loop_figure(
+        _eyes_closed(experiments.track(DEFAULT, sigmas=[4.5]))[0], CLOSE, np.ones(101)),
+     "prediction must start from this run's estimate"),
     (lambda: experiments.track(DEFAULT).open_loop_figure(
         _eyes_closed(experiments.track(DEFAULT))[0], CLOSE, np.ones(100)),
      r"prediction_std must have shape \(101,\)"),
