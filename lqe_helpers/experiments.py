@@ -4,12 +4,11 @@ Notebooks, explorers and checks call these instead of assembling C, R, P0 and no
 by hand, so a question's setup is written once: :func:`filter_model` is the one
 builder of the model a filter assumes (A, C, Q, R, z0, P0), :func:`track` simulates
 the sensors and runs that filter, :func:`delay_and_compensate` delays its output.
-Their results draw their own standard figures (:meth:`Tracking.figure`, ``.error_figure``,
-:meth:`DelayedTracking.figure`, built by :mod:`lqe_helpers.figures`, imported only when a
-figure is asked for); :mod:`lqe_helpers.own_runs` wraps a student's own arrays in them.
+Their results draw their own figures through :mod:`lqe_helpers.figures`
+(:meth:`Tracking.figure`, ``.error_figure`` and those of :mod:`lqe_helpers.tracking_figures`,
+:meth:`DelayedTracking.figure`); :mod:`lqe_helpers.own_runs` wraps a student's arrays in them.
 
-Each public function checks its inputs once, at its entry; what it calls inside
-(:mod:`lqe_helpers._matrices`) checks nothing again.
+Each public function checks its inputs once, at its entry (:mod:`._matrices` checks nothing again).
 """
 
 from __future__ import annotations
@@ -25,6 +24,7 @@ from .filter import FilterResult, kalman_filter
 from .prediction import predict_ahead
 from .scenario import Scenario
 from .steady_state import SteadyState, steady_state
+from .tracking_figures import TrackingFigures
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -104,7 +104,7 @@ class FilterModel:
 
 
 @dataclass(frozen=True)
-class Tracking:
+class Tracking(TrackingFigures):
     """One filtering experiment: what the sensors said and what the filter made of it.
 
     Attributes

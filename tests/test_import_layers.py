@@ -6,8 +6,9 @@ Layers, bottom to top (issue 18):
   ``lqe_helpers`` not named below, e.g. ``model``, ``filter``, ``scenario``);
 * drawing: ``plotting`` and ``figures`` (figures take arrays, so they import no
   experiment and no explorer);
-* experiments: ``experiments``, ``own_runs``, ``systematic_error`` and ``bias_model``, whose
-  results may draw themselves through ``figures``, and ``jerk_tuning``, which runs experiments;
+* experiments: ``experiments``, ``tracking_figures``, ``own_runs``, ``systematic_error`` and
+  ``bias_model``, whose results may draw themselves through ``figures``, and ``jerk_tuning``,
+  which runs experiments;
 * explorers and checks, side by side: neither imports the other;
 * authoring: the instructor's tools, which nothing imports but grading;
 * grading: grading a class, built on authoring, which nothing imports.
@@ -46,7 +47,8 @@ def layer_of(module: str) -> str:
     top = parts[0] if parts else ""
     if top in ("plotting", "figures"):
         return "drawing"
-    if top in ("experiments", "own_runs", "systematic_error", "bias_model", "jerk_tuning"):
+    if top in ("experiments", "tracking_figures", "own_runs", "systematic_error", "bias_model",
+               "jerk_tuning"):
         return "experiments"
     if top in ("explorers", "checks", "authoring", "grading"):
         return top

@@ -156,11 +156,28 @@ def result_methods_in_table() -> dict[str, str]:
 def _draw_result_figure(method: str) -> plt.Figure:
     """The figure ``method`` (``Result.method``) draws of a small result of the pack."""
     from lqe_helpers import bias_model, own_runs
+    from lqe_helpers.prediction import open_loop
 
     truth = DEFAULT.truth[:, 0]
     clean = {sigma: truth + 0.1 * sigma for sigma in (1.5, 4.5)}
     delayed = experiments.delay_and_compensate(experiments.track(DEFAULT), 0.1)
+    run = experiments.track(DEFAULT)
+    blind = open_loop(DEFAULT, run.result.estimates[200], run.result.estimate_covariances[200],
+                      0.5)
+    sweep = experiments.track(DEFAULT, p0_variance=[1.0, 1e5], runs=2)
+    labels = ("P0 = diag(1)", "P0 = diag(1e5)")
     calls = {
+        "Tracking.open_loop_figure": lambda: run.open_loop_figure(blind, 200,
+                                                                  blind.position_stds),
+        "Tracking.panels_figure": lambda: run.panels_figure({"same": run}, (2.0, 5.0)),
+        "Tracking.gains_figure": lambda: sweep.gains_figure(labels),
+        "Tracking.belief_figure": lambda: sweep.belief_figure(
+            (sweep.positions - truth).mean(axis=0) ** 2, (0.3, 0.5), 0.1, labels),
+        "InputTracking.signal_figure": lambda: bias_model.track_with_input(
+            DEFAULT).signal_figure(),
+        "InputTracking.settling_figure": lambda: bias_model.InputTracking.settling_figure(
+            {20.0: bias_model.track_with_input(DEFAULT, runs=2)},
+            {1.5: bias_model.track_with_input(DEFAULT, sigma_v=1.5, runs=2)}),
         "Tracking.figure": lambda: experiments.track(DEFAULT).figure(),
         "Tracking.error_figure": lambda: experiments.track(
             DEFAULT, sigmas=[[1.5], [4.5]], runs=2).error_figure(clean),
@@ -179,6 +196,17 @@ def test_the_table_names_the_result_methods_of_notebook_01s_figures() -> None:
     assert table["Tracking.figure"] == "tracking_comparison_figure"
     assert table["NoiseFreeOutputs.figure"] == "lag_figure"
     assert table["Tracking.error_figure"] == "estimate_error_figure"
+
+
+def test_the_table_names_the_result_methods_of_notebooks_00_02_and_06() -> None:
+    """The given cells of 00, 02 and 06 that passed a result's arrays now call these."""
+    table = result_methods_in_table()
+    assert table["Tracking.open_loop_figure"] == "open_loop_figure"
+    assert table["Tracking.panels_figure"] == "tracking_panels_figure"
+    assert table["Tracking.gains_figure"] == "gains_figure"
+    assert table["Tracking.belief_figure"] == "belief_and_error_figure"
+    assert table["InputTracking.signal_figure"] == "acceleration_signal_figure"
+    assert table["InputTracking.settling_figure"] == "bias_settling_figure"
 
 
 @pytest.mark.slow

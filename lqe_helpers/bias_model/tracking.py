@@ -14,6 +14,8 @@ Each public function checks its inputs once, at its entry.
 
 from __future__ import annotations
 
+import numbers
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -43,6 +45,8 @@ if TYPE_CHECKING:
 #: The filter's prior standard deviation of the bias (cm/s²): the observer allows
 #: offsets up to about half the peak acceleration before it has seen anything.
 DEFAULT_BIAS_PRIOR_STD = 50.0
+#: Most batches per panel of :meth:`InputTracking.settling_figure` (its painter's line styles).
+MAX_SETTLING_CURVES = 6
 
 
 def _assemble(scenario: Scenario, sigma_a: float, sigma_v: float,
@@ -168,10 +172,85 @@ class InputTracking:
                                             self.bias_stds, self.bias, runs.bias_rms_error(),
                                             runs.bias_stds[0])
 
+    def signal_figure(self) -> Figure:
+        """Notebook 06's Figure 3: this run's acceleration signal beside a and a + b.
+
+        Built by :func:`lqe_helpers.figures.acceleration_signal_figure` from this run's
+        readings, the scenario's true mean acceleration per step
+        (:func:`~lqe_helpers.bias_model.equations.step_accelerations`) and the true bias.
+
+        Raises
+        ------
+        ValueError
+            If this tracking is not a single run.
+        """
+        from .. import figures
+
+        if self.readings.ndim != 1:
+            raise ValueError(f"signal_figure draws a single run: this tracking has leading "
+                             f"axes {self.readings.shape[:-1]}")
+        return figures.acceleration_signal_figure(self.scenario.times, self.readings,
+                                                  step_accelerations(self.scenario), self.bias)
+
+    @staticmethod
+    def settling_figure(by_bias: Mapping[float, InputTracking],
+                        by_sigma_v: Mapping[float, InputTracking]) -> Figure:
+        """Notebook 06's Figure 6: how b̂ settles, by true bias and by vision's noise.
+
+        Built by :func:`lqe_helpers.figures.bias_settling_figure`: left, each batch of
+        ``by_bias``: its runs' mean error of b̂ (labelled "b = 20 cm/s²", …); right, each
+        batch of ``by_sigma_v``: the filter's own σ of b̂, the same in every run
+        (labelled "σ_v = 1.5 cm", …).
+
+        Parameters
+        ----------
+        by_bias : mapping of float to InputTracking
+            True bias b (cm/s²) → Monte Carlo runs (one leading axis) at that bias, 1 to
+            :data:`MAX_SETTLING_CURVES` of them, in the order drawn.
+        by_sigma_v : mapping of float to InputTracking
+            σ_v (cm) → Monte Carlo runs at that vision noise, likewise.
+
+        Raises
+        ------
+        ValueError
+            If a mapping holds no batch or too many, a key is not its batch's b or σ_v, a
+            value is not Monte Carlo runs, or the batches are of different scenarios.
+        """
+        from .. import figures
+
+        by_bias = _batches("by_bias", by_bias, "bias", "true bias b (cm/s²)")
+        by_sigma_v = _batches("by_sigma_v", by_sigma_v, "sigma_v", "σ_v (cm)")
+        scenario = by_bias[0].scenario
+        if any(batch.scenario != scenario for batch in by_sigma_v):
+            raise ValueError("by_sigma_v must hold runs of the scenario of by_bias's runs")
+        return figures.bias_settling_figure(
+            scenario.times,
+            {f"b = {batch.bias:g} cm/s²": np.mean(batch.bias_estimates - batch.bias, axis=0)
+             for batch in by_bias},
+            {f"σ_v = {batch.sigma_v:g} cm": batch.bias_stds[0] for batch in by_sigma_v})
+
     def dead_reckoning_mse(self) -> np.ndarray:
         """Per-run MSE (cm²) of the dead-reckoned position after the burn-in, shape (...)."""
         return metrics.mse(self.dead_reckoning[..., 0], self.truth[:, 0],
                            self.scenario.burn_in_steps)
+
+
+def _batches(name: str, batches: object, attribute: str, what: str) -> list[InputTracking]:
+    """``batches``' values, checked: 1 to :data:`MAX_SETTLING_CURVES` Monte Carlo runs of
+    one scenario, each under the key of its own ``attribute`` (to 1e-9)."""
+    items = list(batches.items()) if isinstance(batches, Mapping) else []
+    if not 1 <= len(items) <= MAX_SETTLING_CURVES or not all(
+            isinstance(key, numbers.Real) and not isinstance(key, bool)
+            and isinstance(batch, InputTracking) and batch.bias_estimates.ndim == 2
+            and batch.scenario == items[0][1].scenario
+            and abs(float(key) - getattr(batch, attribute)) <= 1e-9 for key, batch in items):
+        got = ([f"{key!r}: {type(batch).__name__}" for key, batch in items]
+               if isinstance(batches, Mapping) else type(batches).__name__)
+        raise ValueError(
+            f"{name} must map each {what} to Monte Carlo runs at that value (an "
+            f"InputTracking with one leading axis, all of one scenario), 1 to "
+            f"{MAX_SETTLING_CURVES} of them, got {got}")
+    return [batch for _, batch in items]
 
 
 @dataclass(frozen=True)

@@ -427,3 +427,77 @@ def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
     for wrong_run, runs in ((mc, mc), (run, run), (run, other), (run, "mc")):
         with pytest.raises(ValueError, match=r"single run|runs must be"):
             wrong_run.learning_figure(runs)
+
+
+def test_signal_figure_is_notebook_06s_figure_3_from_one_result() -> None:
+    """``run.signal_figure()`` draws what the run's readings, a and b drew, pixel for pixel;
+    another run (another σ_a) draws another figure."""
+    import matplotlib.pyplot as plt
+
+    from lqe_helpers import figures, plotting
+
+    run = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS)
+    by_arrays = figures.acceleration_signal_figure(
+        DEFAULT.times, run.readings, bias_model.step_accelerations(DEFAULT), DEFAULT_BIAS)
+    by_object = run.signal_figure()
+    noisier = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS, sigma_a=400.0)
+    other = noisier.signal_figure()
+    try:
+        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
+        assert plotting.figure_png(other) != plotting.figure_png(by_arrays)
+    finally:
+        for fig in (by_arrays, by_object, other):
+            plt.close(fig)
+    with pytest.raises(ValueError, match="single run"):
+        bias_model.track_with_input(DEFAULT, runs=2).signal_figure()
+
+
+def _batches(biases: tuple[float, ...], sigmas: tuple[float, ...], runs: int = 3,
+             ) -> tuple[dict, dict]:
+    return ({b: bias_model.track_with_input(DEFAULT, bias=b, runs=runs) for b in biases},
+            {s: bias_model.track_with_input(DEFAULT, sigma_v=s, runs=runs) for s in sigmas})
+
+
+def test_settling_figure_is_notebook_06s_figure_6_from_the_runs() -> None:
+    """``InputTracking.settling_figure(by_bias, by_sigma_v)`` draws what the notebook's
+    arrays drew, pixel for pixel; other runs draw another figure."""
+    import matplotlib.pyplot as plt
+
+    from lqe_helpers import figures, plotting
+
+    by_bias, by_sigma_v = _batches((-60.0, 20.0), (0.5, 4.5))
+    by_arrays = figures.bias_settling_figure(
+        DEFAULT.times,
+        {f"b = {b:g} cm/s²": np.mean(batch.bias_estimates - b, axis=0)
+         for b, batch in by_bias.items()},
+        {f"σ_v = {s} cm": batch.bias_stds[0] for s, batch in by_sigma_v.items()})
+    by_object = bias_model.InputTracking.settling_figure(by_bias, by_sigma_v)
+    other = bias_model.InputTracking.settling_figure(*_batches((-60.0, 0.0), (0.5, 1.5)))
+    try:
+        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
+        assert plotting.figure_png(other) != plotting.figure_png(by_arrays)
+    finally:
+        for fig in (by_arrays, by_object, other):
+            plt.close(fig)
+
+
+@pytest.mark.parametrize(("change", "message"), [
+    (lambda by_bias, by_sigma_v: ({}, by_sigma_v), "by_bias must map"),
+    (lambda by_bias, by_sigma_v: ({21.0: by_bias[20.0]}, by_sigma_v), "by_bias must map"),
+    (lambda by_bias, by_sigma_v: ({True: by_bias[20.0]}, by_sigma_v), "by_bias must map"),
+    (lambda by_bias, by_sigma_v: (
+        {20.0: bias_model.track_with_input(DEFAULT)}, by_sigma_v), "by_bias must map"),
+    (lambda by_bias, by_sigma_v: ([by_bias[20.0]], by_sigma_v), "by_bias must map"),
+    (lambda by_bias, by_sigma_v: (by_bias, {1.5: by_bias[20.0], 0.5: by_sigma_v[1.5]}),
+     "by_sigma_v must map"),
+    (lambda by_bias, by_sigma_v: (
+        by_bias, {float(s): bias_model.track_with_input(DEFAULT, sigma_v=float(s), runs=2)
+                  for s in range(1, 8)}), "by_sigma_v must map"),
+    (lambda by_bias, by_sigma_v: (by_bias, {1.5: bias_model.track_with_input(
+        dataclasses.replace(DEFAULT, seed=DEFAULT.seed + 1), runs=2)}),
+     "by_sigma_v must hold runs of the scenario of by_bias"),
+])
+def test_settling_figure_refuses_bad_runs_naming_the_parameter(change, message) -> None:
+    by_bias, by_sigma_v = _batches((20.0,), (1.5,), runs=2)
+    with pytest.raises(ValueError, match=message):
+        bias_model.InputTracking.settling_figure(*change(by_bias, by_sigma_v))
