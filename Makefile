@@ -82,10 +82,12 @@ test-fast: $(STAMP) lint
 	$(BIN)/python -m pytest $(PYTEST_PARALLEL) -p no:nbval --durations=10 tests \
 	  -m "not kernel and not browser and not slow" $(PYTEST_ARGS)
 
-# Re-execute every notebook in a fresh kernel and save it with its outputs (for authors).
+# Re-execute every notebook in a fresh kernel and save it with its outputs (for authors),
+# after writing the given cells' keys and places from the notebooks' code (which execution
+# does not change): a changed given cell with a stale key would count as a student's.
 notebooks: $(STAMP)
-	$(BIN)/python -m lqe_helpers.authoring.notebook_runner notebooks/*.ipynb
 	$(BIN)/python -m lqe_helpers.authoring.given_cells --source notebooks
+	$(BIN)/python -m lqe_helpers.authoring.notebook_runner notebooks/*.ipynb
 
 # HTML handouts in build/handouts/ (index.html; prose/ without code), executed afresh.
 handouts: $(STAMP)

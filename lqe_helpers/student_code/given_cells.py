@@ -12,7 +12,7 @@ notebook ends that trail (its values are the task's inputs); a given cell from f
 (a student may run it early) does not.
 
 ``_given_cell_keys.py`` is written by ``python -m lqe_helpers.authoring.given_cells``
-(``make notebooks`` runs it after executing the notebooks);
+(``make notebooks`` runs it before executing the notebooks);
 ``tests/student_code/test_given_cells.py`` fails when it is not current.
 """
 
