@@ -272,6 +272,12 @@ def _candidates(output: np.ndarray, delayed: bool, late: int) -> list[np.ndarray
     return found
 
 
+def _saved_calls(run: task_runs.TaskRun) -> list[task_runs.SavedCall]:
+    """The calls of the student's saved functions made by ``run`` and by the cells of the
+    student's whose values it draws on (a task written over two cells)."""
+    return [call for cell in task_runs.ancestry(run) for call in cell.saved_calls]
+
+
 def _produced_by(value: object, wanted: Produced, run: task_runs.TaskRun) -> bool:
     try:
         value = np.asarray(value, dtype=float)
@@ -281,7 +287,7 @@ def _produced_by(value: object, wanted: Produced, run: task_runs.TaskRun) -> boo
         return True
     missing = np.isnan(value).reshape(len(value), -1).all(axis=1)
     late = int(np.argmin(missing)) if not missing.all() else len(value)
-    for call in run.saved_calls:
+    for call in _saved_calls(run):
         if call.name != wanted.function:
             continue
         try:
@@ -312,9 +318,10 @@ def task_problem(check: str, args: tuple, run: task_runs.TaskRun) -> str | None:
     for wanted in DRIVEN.get(check, ()):
         if wanted.position >= len(args):
             continue
-        called = any(call.name == wanted.function for call in run.saved_calls)
+        called = any(call.name == wanted.function for call in _saved_calls(run))
         if not called:
-            return (f"the task cell above does not run your {wanted.function}: this task is "
+            return (f"the task cell above does not run your {wanted.function} (nor does a "
+                    f"cell of yours whose values it uses): this task is "
                     f"done with your own {wanted.function} (loaded from my_functions/). Use it "
                     f"there, run that cell, then this check again")
     return None

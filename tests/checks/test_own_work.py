@@ -1036,3 +1036,24 @@ def test_a_given_cell_from_further_on_that_makes_an_input_again_leaves_the_task_
                               "R = np.diag([sigma_v**2, sigma_p**2])\n", earlier=(later,))
     assert isinstance(error, CheckFailed), (error, printed)
     assert "comes after this task" in str(error), str(error)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("notebook", "check", "first", "second"), [
+    ("05_sensory_delay", "check_delay_signals",
+     "estimates = my_filter(y, vision.A, vision.C, vision.Q, vision.R, vision.z0, vision.P0)\n"
+     "z_star = compensate(estimates, vision.A, steps)\n",
+     "late_readings = simulation.delay_signal(y, steps)[:, 0]\n"
+     "delayed = simulation.delay_signal(estimates, steps)[:, 0]\n"
+     "compensated = z_star[:, 0]\n"),
+    ("02_initial_covariance", "check_start_of_trial", None,
+     "estimates_small = estimates_small.copy()\n"),
+])
+def test_a_one_trial_task_written_over_two_cells_passes(notebook, check, first, second,
+                                                        folder) -> None:
+    """The seventh trial (F1): the task cell runs my_filter (and compensate), and a cell of
+    the student's after it makes the checked values from its results: "the task cell above
+    does not run your my_filter" was a false refusal. The saved functions' calls of the
+    cells the values are drawn from count."""
+    error, printed = run_task(notebook, check, first, before_check=second)
+    assert error is None and printed.startswith("✓ "), (error, printed)
