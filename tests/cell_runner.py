@@ -55,10 +55,15 @@ class CellRunner:
         self.count += 1
         filename = f"<cell In[{self.count}]>"
         linecache.cache[filename] = (len(source), None, source.splitlines(True), filename)
+        error = code = None
+        try:  # compiled here, as IPython compiles a cell: not by the cell's own code
+            code = compile(source, filename, "exec")
+        except SyntaxError as caught:
+            error = caught
         self.events.trigger("pre_run_cell", SimpleNamespace(raw_cell=source))
-        error = None
         try:
-            exec(compile(source, filename, "exec"), self.namespace)
+            if code is not None:
+                exec(code, self.namespace)
         except Exception as caught:  # a cell's error, as IPython reports it
             error = caught
         self.events.trigger("post_run_cell",

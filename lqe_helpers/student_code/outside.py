@@ -16,7 +16,10 @@ when it drops a hook that raised, which the pack's hooks say first: :func:`dropp
 starting a thread
 (whose calls no hook of this thread sees), or making a function from another's code by hand
 (``code.replace``, ``types.FunctionType``, ``marshal``, ``__code__``: a pack function under
-another file's name), or C code through ``ctypes`` (a thread of its own, say).
+another file's name), or code made from text (``compile``, ``exec`` or ``eval`` of a
+string: the pack's own source read and run under another name, say), or C code through
+``ctypes`` (a thread of its own, say). Python's and the libraries' own uses (IPython
+compiling a cell, ``dataclasses``) are not the student's.
 
 Files of the installation are not news: Python's and its packages' (``sys.prefix``, the
 site folders), the pack's modules, the system's folders, matplotlib's and IPython's settings
@@ -51,6 +54,7 @@ TAMPERING = {"sys.setprofile": "switches off the pack's watch of the functions i
              "ctypes.dlopen": "uses C code through ctypes, whose calls the pack cannot watch",
              "ctypes.dlsym": "uses C code through ctypes, whose calls the pack cannot watch",
              "marshal.loads": "loads code with marshal",
+             "compile": "makes code from text (compile, exec or eval)",
              "object.__setattr__": "replaces a function's code (__code__)",
              "sys._getframe": "looks into the frames of the code that runs (sys._getframe)",
              "object.__getattr__": "looks into the frames of a traceback or a generator",

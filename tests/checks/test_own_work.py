@@ -1057,3 +1057,20 @@ def test_a_one_trial_task_written_over_two_cells_passes(notebook, check, first, 
     cells the values are drawn from count."""
     error, printed = run_task(notebook, check, first, before_check=second)
     assert error is None and printed.startswith("✓ "), (error, printed)
+
+
+@pytest.mark.slow
+def test_the_packs_source_run_under_another_name_in_a_task_cell_fails(folder) -> None:
+    """The seventh trial (L1): 03 Task 1 from the pack's own _matrices.py, read and run with
+    exec under another file name, passed: code made from text by the student's own cell."""
+    code = ("from lqe_helpers import _matrices\n"
+            "_ns = {'__name__': 'mine'}\n"
+            "exec(compile(open(_matrices.__file__).read().replace('from .', 'from lqe_helpers.'),"
+            " 'mine.py', 'exec'), _ns)\n"
+            "C = _ns['observation'](2)\n"
+            "R = _ns['noise_covariance'](np.array([sigma_v, sigma_p]))\n")
+    error, printed = run_task("03_fusion", "check_fusion", code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, printed = run_task("03_fusion", "check_fusion", code)
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "the task cell above makes code from text" in str(error), str(error)
