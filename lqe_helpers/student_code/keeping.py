@@ -83,6 +83,46 @@ def _names_from_outside(source: str, name: str) -> set[str]:
     return used - {name}
 
 
+def _source_of(function: types.FunctionType, name: str) -> str:
+    """The code of ``function``, one ``def`` at the top of a cell (dedented)."""
+    try:
+        with unheard():  # the pack reading the student's code, not the student a file
+            source = textwrap.dedent(inspect.getsource(function))
+        tree = ast.parse(source)
+    except (OSError, TypeError, SyntaxError):
+        raise StudentCodeError(
+            f"save could not read the code of {name}: define it with def in a notebook "
+            f"cell and run that cell first") from None
+    if len(tree.body) != 1 or not isinstance(tree.body[0], ast.FunctionDef):
+        raise StudentCodeError(f"save could not read the code of {name} as one def")
+    return source
+
+
+def _self_contained(function: types.FunctionType,
+                    name: str) -> tuple[list[str], set[str], list[str]]:
+    """The code to save for ``function`` (its own last, after the helper functions of the
+    notebook it calls, each under the same rule), the names it looks up outside, and those
+    of the notebook it may not use (sorted)."""
+    sources, outside, foreign = [], set(), set()
+    queue, seen = [(function, name)], {name}
+    while queue:
+        current, current_name = queue.pop()
+        source = _source_of(current, current_name)
+        sources.insert(0, source)
+        for word in _names_from_outside(source, current_name) - seen:
+            outside.add(word)
+            value = function.__globals__.get(word)
+            if (isinstance(value, types.FunctionType) and not value.__closure__
+                    and value.__globals__ is function.__globals__
+                    and value.__name__ == word):  # a helper of the student's: saved too
+                seen.add(word)
+                queue.append((value, word))
+            elif word != "np" and (word in function.__globals__
+                                   or not hasattr(builtins, word)):
+                foreign.add(word)
+    return sources, outside - seen, sorted(foreign)
+
+
 def save(function: Callable, folder: str | os.PathLike | None = None) -> Callable:
     """Keep a student's function for later notebooks: ``my_functions/<name>.py``.
 
@@ -96,8 +136,8 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
     ----------
     function : callable
         A function defined with ``def`` at the top of a notebook cell. It may use its
-        arguments, numpy as ``np`` and Python's built-ins only (the later notebook
-        does not have the others).
+        arguments, numpy as ``np``, Python's built-ins and functions of the notebook under
+        the same rule (saved with it) only (the later notebook does not have the others).
     folder : path, optional
         Where to write; default :data:`SAVE_FOLDER` in the working folder of the first save
         or load of this session (in Jupyter, the notebook's folder): :func:`save_folder`.
@@ -122,27 +162,16 @@ def save(function: Callable, folder: str | os.PathLike | None = None) -> Callabl
         raise StudentCodeError(
             f"{name} is defined inside another function; save needs a function defined "
             f"at the top of a cell")
-    try:
-        with unheard():  # the pack reading the student's code, not the student a file
-            source = textwrap.dedent(inspect.getsource(function))
-        tree = ast.parse(source)
-    except (OSError, TypeError, SyntaxError):
-        raise StudentCodeError(
-            f"save could not read the code of {name}: define it with def in a notebook "
-            f"cell and run that cell first") from None
-    if len(tree.body) != 1 or not isinstance(tree.body[0], ast.FunctionDef):
-        raise StudentCodeError(f"save could not read the code of {name} as one def")
-    outside = _names_from_outside(source, name)
-    foreign = sorted(word for word in outside
-                     if word != "np" and (word in function.__globals__
-                                          or not hasattr(builtins, word)))
+    sources, outside, foreign = _self_contained(function, name)
     if "np" in outside and function.__globals__.get("np", np) is not np:
         foreign.insert(0, "np (which is not numpy in your notebook)")
     if foreign:
         raise StudentCodeError(
             f"{name} uses {', '.join(foreign)} from the notebook; a saved function may use "
-            f"only its arguments, numpy as np and Python's built-ins. Pass the others in "
+            f"only its arguments, numpy as np, Python's built-ins and functions of yours "
+            f"defined with def at the top of a cell under the same rule. Pass the others in "
             f"as arguments (or compute them inside), run its cell, then this one again")
+    source = "\n\n".join(sources)
     imports = "import numpy as np\n\n\n" if "np" in outside else "\n"
     text = (f"{SAVE_HEADER}\n# Loaded in later notebooks by student_code.load({name!r}).\n"
             f"{imports}{source.rstrip()}\n")

@@ -320,6 +320,31 @@ def test_save_writes_the_source_and_returns_the_function_loaded_back(tmp_path, c
     assert student_code.load("doubled", folder)(1) == 2
 
 
+def gain(P, C, R):
+    return P @ C.T @ np.linalg.inv(C @ P @ C.T + R)
+
+
+def uses_a_helper(P, C, R):
+    return 2 * gain(P, C, R) + twice(1)
+
+
+def twice(x):
+    return gain(np.eye(1), np.eye(1), np.eye(1)) * 0 + 2 * x
+
+
+def test_save_keeps_the_helper_functions_of_the_notebook_it_calls(tmp_path, capsys) -> None:
+    """The seventh trial (F2): a right my_filter that calls a helper of its own cell printed
+    ✓, then could not be saved ("uses gain from the notebook"). A helper defined with def at
+    the top of a cell, under the same rule, is saved with it (each once)."""
+    loaded = student_code.save(uses_a_helper, tmp_path)
+    text = (tmp_path / "uses_a_helper.py").read_text("utf-8")
+    assert text.count("def gain(") == 1 and text.count("def twice(") == 1
+    assert text.index("def gain(") < text.index("def uses_a_helper(")
+    P, C, R = np.eye(2), np.ones((1, 2)), np.eye(1)
+    assert np.allclose(loaded(P, C, R), uses_a_helper(P, C, R))
+    assert student_code.load("uses_a_helper", tmp_path)(P, C, R).shape == (2, 1)
+
+
 def test_save_rewrites_only_a_changed_file_of_its_own(tmp_path, capsys) -> None:
     folder = tmp_path / "my_functions"
     student_code.save(doubled, folder)
@@ -353,7 +378,7 @@ def test_save_never_replaces_a_file_it_did_not_write(tmp_path) -> None:
 
 
 def test_save_refuses_names_from_the_notebook(tmp_path, monkeypatch) -> None:
-    with pytest.raises(StudentCodeError, match=r"^scaled uses SCALE, helper from the notebook; "
+    with pytest.raises(StudentCodeError, match=r"^scaled uses SCALE from the notebook; "
                                                r"a saved function may use only its arguments"):
         student_code.save(scaled, tmp_path)
     monkeypatch.setitem(globals(), "sum", lambda x: 0)       # the notebook shadows a built-in

@@ -144,8 +144,9 @@ def test_a_saved_function_loads_in_a_fresh_kernel(executed) -> None:
     assert name == "StudentCodeError"
     assert shown.rstrip().endswith(
         "StudentCodeError: tripled uses factor from the notebook; a saved function may use only "
-        "its arguments, numpy as np and Python's built-ins. Pass the others in as arguments (or "
-        "compute them inside), run its cell, then this one again")
+        "its arguments, numpy as np, Python's built-ins and functions of yours defined with def "
+        "at the top of a cell under the same rule. Pass the others in as arguments (or compute "
+        "them inside), run its cell, then this one again")
     assert_only_the_students_code(shown)
     (folder / "my_functions" / "my_filter.py").write_text(SAVED_RAISING, "utf-8")
     later = run(["from lqe_helpers import student_code\n"
