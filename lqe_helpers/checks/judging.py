@@ -422,8 +422,28 @@ def mse_mistakes(estimate: np.ndarray, truth: np.ndarray, burn_in_steps: int,
                          f"{seconds:g} s, which is {burn_in_steps} samples of {dt:g} s; "
                          f"count it in samples"] = np.mean(error[..., int(seconds):] ** 2,
                                                            axis=-1)
+        if burn_in_steps:
+            mistakes.update(other_burn_ins(error, burn_in_steps, dt))
     return {cause: (value if np.all(np.isfinite(value)) else None)
             for cause, value in mistakes.items()}
+
+
+def other_burn_ins(error: np.ndarray, burn_in_steps: int,
+                   dt: float | None = None) -> dict[str, np.ndarray]:
+    """The MSE of ``error`` (cm, shape (..., n)) after any other burn-in: cause → MSE (cm²,
+    shape (...)), for every first sample kept from 1 to n − 1 but the right one and its
+    neighbours (named by :func:`burn_in_slips`). Tried after the named slips."""
+    n = error.shape[-1]
+    tails = np.cumsum((error**2)[..., ::-1], axis=-1)[..., ::-1]  # sum from each sample on
+    named = {burn_in_steps, *burn_in_slips(burn_in_steps, n).values()}
+    found = {}
+    for start in range(1, n):
+        if start not in named:
+            seconds = f" ({start * dt:g} s)" if dt is not None else ""
+            found[f"it leaves out the first {start} samples{seconds}, not the burn-in's "
+                  f"{burn_in_steps}: keep the samples from index {burn_in_steps} on"] = (
+                tails[..., start] / (n - start))
+    return found
 
 
 def readings_mistakes(estimate: np.ndarray, burn_in_steps: int,

@@ -113,7 +113,7 @@ def task2(mistake: str = "") -> tuple[np.ndarray, np.ndarray, float, float]:
     if mistake == "metres":
         fused = reference.lqe_filter(y / 100, A, C, Q, R, z0, P0)[:, 0]
     start = {"burn-in in seconds": 1, "whole trial": 0, "burn-in + 1": burn + 1,
-             "burn-in - 1": burn - 1}.get(mistake, burn)
+             "burn-in - 1": burn - 1, "burn-in of 2 s": 2 * burn}.get(mistake, burn)
     mse_fused = np.mean((fused[start:] - truth[start:]) ** 2) if fused.ndim == 1 else 0.0
     mse_vision = np.mean((vision[start:] - truth[start:]) ** 2)
     if mistake == "against the readings":
@@ -161,6 +161,9 @@ def test_check_fusion_trial_passes_the_worked_solution(capsys) -> None:
                              "(column 0 of y), not with the true position"),
     ("burn-in + 1", "is not right: it leaves out one sample too many (101 instead of 100)"),
     ("burn-in - 1", "is not right: it leaves out one sample too few (99 instead of 100)"),
+    ("burn-in of 2 s", "mse_vision_trial = 0.325 cm²"),  # the seventh trial (G1): any burn-in
+    ("burn-in of 2 s", "is not right: it leaves out the first 200 samples (2 s), not the "
+                       "burn-in's 100: keep the samples from index 100 on"),
     ("P0 large", "vision_positions is not right: P0 is diag(1e5), notebook 02's uncertain "
                  "start: this question starts from P0 = diag(1)"),
     ("metres", "fused_positions is not right: the readings are in metres"),
@@ -199,7 +202,7 @@ def task3(mistake: str = "") -> tuple[np.ndarray, np.ndarray, object]:
     vision_mc = experiments.track(DEFAULT, ("vision",), runs=runs)
     fused_mc = experiments.track(DEFAULT, FUSED, runs=runs)
     start = {"burn-in in seconds": 1, "whole trial": 0, "burn-in + 1": burn + 1,
-             "burn-in - 1": burn - 1}.get(mistake, burn)
+             "burn-in - 1": burn - 1, "burn-in of 50": burn // 2}.get(mistake, burn)
     mse_vision = metrics.mse(vision_mc.positions, truth, start)
     mse_fused = metrics.mse(fused_mc.positions, truth, start)
     difference = metrics.mean_ci95(mse_vision - mse_fused)
@@ -260,6 +263,8 @@ def test_check_fusion_difference_passes_the_worked_solution(capsys) -> None:
     ("burn-in - 1", "difference is not right: it leaves out one sample too few (99 instead "
                     "of 100)"),
     ("runs not paired", "is not right: its runs are not paired: the mean is right"),
+    ("burn-in of 50", "mse_vision is not right: it leaves out the first 50 samples (0.5 s), "
+                      "not the burn-in's 100"),  # the seventh trial (G1)
 ])
 @pytest.mark.slow
 def test_check_fusion_difference_names_each_realistic_mistake(mistake: str, phrase: str) -> None:
