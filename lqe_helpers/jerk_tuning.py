@@ -73,6 +73,16 @@ class JerkChoice:
         parabola in ln σ_j."""
         return _refined_extreme(self.jerk_stds, self.mse.mean(axis=0), largest=False)
 
+    def figure(self, chosen: dict[str, float]):
+        """The three criteria against σ_j, with the σ_j each picks marked (``chosen``: keys
+        "likelihood", "NIS", "MSE", σ_j in cm/s³), drawn by
+        :func:`lqe_helpers.figures.jerk_choice_figure` from the means over the runs."""
+        from . import figures
+
+        return figures.jerk_choice_figure(self.jerk_stds, self.log_likelihood.mean(axis=0),
+                                          self.nis_mean, self.mse.mean(axis=0), chosen,
+                                          expected_nis=float(self.sensors))
+
     @property
     def by_likelihood_per_run(self) -> np.ndarray:
         """The σ_j (cm/s³) each single run's likelihood picks, shape (runs,): what one

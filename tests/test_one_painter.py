@@ -155,7 +155,7 @@ def result_methods_in_table() -> dict[str, str]:
 
 def _draw_result_figure(method: str) -> plt.Figure:
     """The figure ``method`` (``Result.method``) draws of a small result of the pack."""
-    from lqe_helpers import bias_model, own_runs
+    from lqe_helpers import bias_model, jerk_tuning, own_runs
     from lqe_helpers.prediction import open_loop
 
     truth = DEFAULT.truth[:, 0]
@@ -187,6 +187,9 @@ def _draw_result_figure(method: str) -> plt.Figure:
         "DelayedTracking.comparison_figure": delayed.comparison_figure,
         "InputTracking.learning_figure": lambda: bias_model.track_with_input(
             DEFAULT).learning_figure(bias_model.track_with_input(DEFAULT, runs=2)),
+        "JerkChoice.figure": lambda: jerk_tuning.tune_jerk_std(
+            DEFAULT, [300.0, 1000.0, 3000.0], runs=2).figure(
+                {"likelihood": 1000.0, "NIS": 1000.0, "MSE": 1000.0}),
     }
     return calls[method]()
 
@@ -207,6 +210,7 @@ def test_the_table_names_the_result_methods_of_notebooks_00_02_and_06() -> None:
     assert table["Tracking.belief_figure"] == "belief_and_error_figure"
     assert table["InputTracking.signal_figure"] == "acceleration_signal_figure"
     assert table["InputTracking.settling_figure"] == "bias_settling_figure"
+    assert table["JerkChoice.figure"] == "jerk_choice_figure"
 
 
 @pytest.mark.slow
