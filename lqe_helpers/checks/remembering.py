@@ -3,7 +3,7 @@
 ``functools.cache`` wraps a function in C: a call that finds its value cached runs no
 Python code, so the record of a task cell (:mod:`~lqe_helpers.student_code.task_runs`, a
 profile hook) would not see a student's cell take a check's cached answer. The wrapper of
-:func:`remembered` is a Python function that bears the wrapped function's module and name,
+:func:`remembered` is a Python function that bears the wrapped function's file and name,
 so every call, cached or not, is recorded as that function of the pack.
 """
 
@@ -29,7 +29,8 @@ def remembered(function: Callable[..., Result]) -> Callable[..., Result]:
         return values[key]
 
     code = remembered_call.__code__.replace(co_name=function.__name__,
-                                           co_qualname=function.__qualname__)
+                                           co_qualname=function.__qualname__,
+                                           co_filename=function.__code__.co_filename)
     named = types.FunctionType(code, function.__globals__, function.__name__,
                                remembered_call.__defaults__, remembered_call.__closure__)
     functools.update_wrapper(named, function)

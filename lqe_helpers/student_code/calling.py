@@ -266,9 +266,19 @@ def shown_function(name: str) -> str:
 
 
 def pack_name(frame: types.FrameType) -> str:
-    """"lqe_helpers.filter._covariance_sequence" for a frame of the pack's code."""
-    module = frame.f_globals.get("__name__", "lqe_helpers")
-    return f"{module}.{frame.f_code.co_qualname}"
+    """"lqe_helpers.filter._covariance_sequence" for a frame of the pack's code: the module
+    named by the code's file, whatever name the module was run under (a pack file imported
+    as another module is the pack's all the same)."""
+    return f"{_module_of(frame.f_code.co_filename)}.{frame.f_code.co_qualname}"
+
+
+@functools.lru_cache(maxsize=1024)
+def _module_of(filename: str) -> str:
+    """"lqe_helpers.filter" for the pack's file .../lqe_helpers/filter.py."""
+    relative = os.path.relpath(os.path.realpath(filename), os.path.dirname(
+        _PACK_FOLDER.rstrip(os.sep)))
+    parts = os.path.splitext(relative)[0].split(os.sep)
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
 

@@ -1074,3 +1074,23 @@ def test_the_packs_source_run_under_another_name_in_a_task_cell_fails(folder) ->
     error, printed = run_task("03_fusion", "check_fusion", code)
     assert isinstance(error, CheckFailed), (error, printed)
     assert "the task cell above makes code from text" in str(error), str(error)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("module_name", ["mymat", "lqe_helpers.mine"])
+def test_a_pack_file_imported_under_another_name_in_a_task_cell_fails(module_name,
+                                                                       folder) -> None:
+    """The eighth trial (D2): 03 Task 1 from the pack's _matrices.py imported with importlib
+    under another module name passed: its functions were named by that module. They are
+    named by their file, the pack's."""
+    code = ("import importlib.util as _iu\nfrom lqe_helpers import _matrices as _m\n"
+            f"_spec = _iu.spec_from_file_location({module_name!r}, _m.__file__)\n"
+            "_mm = _iu.module_from_spec(_spec)\n_mm.__package__ = 'lqe_helpers'\n"
+            "_spec.loader.exec_module(_mm)\n"
+            "C = _mm.observation(2)\nR = _mm.noise_covariance(np.array([sigma_v, sigma_p]))\n")
+    error, printed = run_task("03_fusion", "check_fusion", code, watch=False)
+    assert error is None and printed.startswith("✓ "), (error, printed)
+    error, printed = run_task("03_fusion", "check_fusion", code)
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert "the task cell above runs the pack's own _matrices.observation" in str(error), (
+        str(error))
