@@ -44,6 +44,7 @@ import numpy as np
 from ..scenario import Scenario
 from ..student_code import outside, task_runs
 from ..student_code.calling import machinery_function
+from ..student_code.cell_code import untraceable_reads
 from .machinery import FUNCTION_RTOL, CheckFailed, close
 
 __tracebackhide__ = True  # pytest: leave these frames out of a failure's traceback
@@ -241,23 +242,30 @@ def trail_problem(check: str, run: task_runs.TaskRun) -> str | None:
     took something from outside the notebook (a file it read, another program it ran:
     :attr:`~lqe_helpers.student_code.task_runs.TaskRun.outside`), whose numbers the record
     cannot trace; or the values come from a cell the notebook gives further on, run before
-    its turn."""
+    its turn, or reach the cell by names made as it runs (``globals()[...]``, ``builtins``,
+    ``Out``: :func:`~lqe_helpers.student_code.cell_code.untraceable_reads`)."""
     used = forbidden_calls(check, run)
     if used:
         return forbidden_text(used[0], run)
     for cell in task_runs.ancestry(run):
+        where = ("the task cell above" if cell.number == run.number else
+                 f"a cell you ran before the task cell (`{cell.first_line[:60]}`), whose "
+                 f"values it uses,")
+        if cell.outside:
+            return (f"{where} {cell.outside[0]}. {outside.UNTRACEABLE}. Compute them in "
+                    f"the notebook itself, with your own code, run that cell, then this check "
+                    f"again")
         if cell.given:  # on the trail, a given cell comes after the task (see ancestry)
             return (f"the task cell above uses {_drawn(cell, run)} from a cell of the "
                     f"notebook that comes after this task (`{cell.first_line[:60]}`), which "
                     f"you ran before it: its values are the notebook's, not your own work. "
                     f"Make them in the task cell with your own code, run it, then this check")
-        if cell.outside:
-            where = ("the task cell above" if cell.number == run.number else
-                     f"a cell you ran before the task cell (`{cell.first_line[:60]}`), whose "
-                     f"values it uses,")
-            return (f"{where} {cell.outside[0]}. {outside.UNTRACEABLE}. Compute them in "
-                    f"the notebook itself, with your own code, run that cell, then this check "
-                    f"again")
+        reads = untraceable_reads(cell.source)
+        if reads:
+            return (f"{where} reaches values through {', '.join(reads)}: a value found by a "
+                    f"name made as the code runs, or kept outside the notebook's names, "
+                    f"cannot be traced to your own work. Use the variables by their names, "
+                    f"run the cell, then this check again")
     return None
 
 

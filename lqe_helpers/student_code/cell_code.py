@@ -189,3 +189,40 @@ def calls_a_check(source: str) -> bool:
     return any(isinstance(node, ast.Call) and (
         getattr(node.func, "attr", "") or getattr(node.func, "id", "")).startswith("check_")
         for node in ast.walk(tree))
+
+
+#: Ways to reach a value by a name made as the code runs (or kept outside the cell's
+#: names), whose origin a check cannot trace: what each is called in a message.
+_NAMESPACE_CALLS = {"globals": "globals()", "vars": "vars()", "locals": "locals()"}
+_NAMESPACE_NAMES = {"builtins": "builtins", "__builtins__": "__builtins__", "Out": "Out",
+                    "_oh": "_oh", "_": "_", "__": "__", "___": "___"}
+_NAMESPACE_ATTRIBUTES = {"user_ns": "user_ns", "__dict__": "__dict__", "modules": "sys.modules",
+                         "environ": "os.environ", "f_locals": "f_locals",
+                         "f_globals": "f_globals"}
+
+
+def untraceable_reads(source: str) -> list[str]:
+    """How a cell's code reaches values by names it makes as it runs, or outside its names
+    (``globals()[...]``, ``getattr(x, name)`` with a name not written out, ``builtins``,
+    ``Out[...]``, ``user_ns``, ``__dict__``, ``sys.modules``, ``os.environ``), each as a
+    message says it, in the order found; [] if none (or the code does not parse)."""
+    try:
+        tree = ast.parse(source)
+    except (SyntaxError, ValueError):
+        return []
+    found: list[str] = []
+    for node in ast.walk(tree):
+        what = ""
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+            if node.func.id in _NAMESPACE_CALLS and not node.args:
+                what = _NAMESPACE_CALLS[node.func.id]
+            elif node.func.id == "getattr" and len(node.args) >= 2 and not isinstance(
+                    node.args[1], ast.Constant):
+                what = "getattr with a name made as the code runs"
+        elif isinstance(node, ast.Name) and isinstance(node.ctx, ast.Load):
+            what = _NAMESPACE_NAMES.get(node.id, "")
+        elif isinstance(node, ast.Attribute) and isinstance(node.ctx, ast.Load):
+            what = _NAMESPACE_ATTRIBUTES.get(node.attr, "")
+        if what and what not in found:
+            found.append(what)
+    return found

@@ -1094,3 +1094,45 @@ def test_a_pack_file_imported_under_another_name_in_a_task_cell_fails(module_nam
     assert isinstance(error, CheckFailed), (error, printed)
     assert "the task cell above runs the pack's own _matrices.observation" in str(error), (
         str(error))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("scratch", "task", "said"), [
+    ("_Ps = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, 100)\n",
+     "two_sigma = 2 * np.sqrt(globals()['_P' + 's'][:, 0, 0])\n", "globals()"),
+    ("_Ps = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, 100)\n",
+     "two_sigma = 2 * np.sqrt(vars()['_P' + 's'][:, 0, 0])\n", "vars()"),
+    ("import builtins\nbuiltins.zz2 = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, "
+     "100)\n", "import builtins\ntwo_sigma = 2 * np.sqrt(builtins.zz2[:, 0, 0])\n", "builtins"),
+    ("import os, json\nos.environ['ZZ'] = json.dumps(propagate_covariance(P_close, A, "
+     "sigma_j**2 * g @ g.T, 100)[:, 0, 0].tolist())\n",
+     "import os, json\ntwo_sigma = 2 * np.sqrt(np.array(json.loads(os.environ['ZZ'])))\n",
+     "os.environ"),
+    ("np.zz4 = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, 100)\n",
+     "two_sigma = 2 * np.sqrt(np.__dict__['zz' + '4'][:, 0, 0])\n", "__dict__"),
+    ("_Ps = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, 100)\n",
+     "two_sigma = 2 * np.sqrt(locals()['_P' + 's'][:, 0, 0])\n", "locals()"),
+    ("np.zz3 = propagate_covariance(P_close, A, sigma_j**2 * g @ g.T, 100)\n",
+     "two_sigma = 2 * np.sqrt(getattr(np, 'zz' + '3')[:, 0, 0])\n", "getattr with a name"),
+])
+def test_a_value_reached_by_a_name_made_at_run_time_fails(scratch, task, said,
+                                                          folder) -> None:
+    """The eighth trial (D1): 00 Task 2's band from a pack result of a scratch cell, reached
+    by a name made as the code runs or kept outside the notebook's names, passed (the trail
+    follows names written in the code)."""
+    code = ("def predict_covariance(P, F, G, sigma):\n"
+            "    return F @ P @ F.T + sigma**2 * G @ G.T\n" + task)
+    error, printed = run_task("00_background_model", "check_eyes_closed", code,
+                              earlier=(scratch,))
+    assert isinstance(error, CheckFailed), (error, printed)
+    assert f"the task cell above reaches values through {said}" in str(error), str(error)
+
+
+def test_the_ways_to_reach_a_value_by_a_run_time_name_are_found_in_a_cells_code() -> None:
+    from lqe_helpers.student_code.cell_code import untraceable_reads
+
+    assert untraceable_reads("x = globals()['a' + 'b']\ny = Out[3]\n") == ["globals()", "Out"]
+    assert untraceable_reads("ip = get_ipython()\nC = ip.user_ns['c']\n") == ["user_ns"]
+    assert untraceable_reads("v = getattr(batch, 'positions')\nC = np.eye(2)\n") == []
+    assert untraceable_reads("P_new = P.copy()\nd = dict(a=1)\nd['a']\n") == []
+    assert untraceable_reads("not python(") == []
