@@ -75,6 +75,24 @@ def png(figure: Figure, dpi: int = 60) -> bytes:
     return buffer.getvalue()
 
 
+def pngs(*figures: Figure, dpi: int = 30) -> list[bytes]:
+    """Each figure rendered to PNG bytes (:func:`png`), then closed (pyplot forgets it)."""
+    import matplotlib.pyplot as plt
+
+    try:
+        return [png(figure, dpi) for figure in figures]
+    finally:
+        for figure in figures:
+            plt.close(figure)
+
+
+def same_png(first: Figure, second: Figure) -> bool:
+    """Whether two figures render to the same PNG (both closed): a result's own figure
+    against its painter fed the same arrays."""
+    first_png, second_png = pngs(first, second)
+    return first_png == second_png
+
+
 def fresh_figure(figsize: tuple[float, float] = (10.0, 5.0)) -> Figure:
     """An empty figure with an Agg canvas, as an explorer makes one."""
     figure = Figure(figsize=figsize)

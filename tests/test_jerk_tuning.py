@@ -89,17 +89,9 @@ def test_bad_input_names_the_parameter(call, message: str) -> None:
 def test_the_choice_draws_the_painters_figure_of_its_means() -> None:
     """Notebook 00's Figure 6 (issue 25): JerkChoice.figure hands its own means over the
     runs to figures.jerk_choice_figure, byte for byte; another grid draws another figure."""
-    import matplotlib.pyplot as plt
-    from explorer_checks import png
+    from explorer_checks import same_png as same
 
     from lqe_helpers import figures
-
-    def same(first, second) -> bool:
-        try:
-            return png(first, dpi=30) == png(second, dpi=30)
-        finally:
-            plt.close(first)
-            plt.close(second)
 
     choice = jerk_tuning.tune_jerk_std(DEFAULT, [300.0, 1000.0, 3000.0, 10000.0], runs=20)
     chosen = {"likelihood": choice.by_likelihood, "NIS": choice.by_nis, "MSE": choice.by_mse}

@@ -8,10 +8,9 @@ from __future__ import annotations
 
 import dataclasses
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pytest
-from explorer_checks import png
+from explorer_checks import same_png
 
 from lqe_helpers import experiments, figures
 from lqe_helpers.prediction import open_loop
@@ -19,15 +18,6 @@ from lqe_helpers.scenario import DEFAULT
 
 CLOSE = round(2.0 / DEFAULT.dt)
 LABELS = ("P0 = diag(1)", "P0 = diag(1e5)")
-
-
-def same_png(first: plt.Figure, second: plt.Figure) -> bool:
-    """Whether two figures render to the same PNG (both closed)."""
-    try:
-        return png(first, dpi=30) == png(second, dpi=30)
-    finally:
-        plt.close(first)
-        plt.close(second)
 
 
 def _eyes_closed(tracking: experiments.Tracking):

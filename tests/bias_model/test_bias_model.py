@@ -7,6 +7,7 @@ import re
 
 import numpy as np
 import pytest
+from explorer_checks import pngs, same_png
 
 from lqe_helpers import bias_model, experiments, metrics, simulation
 from lqe_helpers.filter import kalman_filter
@@ -406,9 +407,7 @@ def test_bad_input_is_rejected_by_name(call, name: str) -> None:
 @pytest.mark.slow
 def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
     """``run.learning_figure(mc)`` draws what six arrays drew, pixel for pixel."""
-    import matplotlib.pyplot as plt
-
-    from lqe_helpers import figures, plotting
+    from lqe_helpers import figures
 
     b_true = bias_model.DEFAULT_BIAS
     run = bias_model.track_with_input(DEFAULT, bias=b_true)
@@ -417,12 +416,7 @@ def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
     np.testing.assert_array_equal(mc.bias_rms_error(), rms)
     by_arrays = figures.bias_learning_figure(DEFAULT.times, run.bias_estimates, run.bias_stds,
                                              b_true, rms, mc.bias_stds[0])
-    by_object = run.learning_figure(mc)
-    try:
-        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
-    finally:
-        plt.close(by_arrays)
-        plt.close(by_object)
+    assert same_png(run.learning_figure(mc), by_arrays)
     other = bias_model.track_with_input(DEFAULT, bias=b_true + 1.0, runs=3)
     for wrong_run, runs in ((mc, mc), (run, run), (run, other), (run, "mc")):
         with pytest.raises(ValueError, match=r"single run|runs must be"):
@@ -432,9 +426,7 @@ def test_learning_figure_is_notebook_06s_figure_1_from_two_results() -> None:
 def test_signal_figure_is_notebook_06s_figure_3_from_one_result() -> None:
     """``run.signal_figure()`` draws what the run's readings, a and b drew, pixel for pixel;
     another run (another σ_a) draws another figure."""
-    import matplotlib.pyplot as plt
-
-    from lqe_helpers import figures, plotting
+    from lqe_helpers import figures
 
     run = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS)
     by_arrays = figures.acceleration_signal_figure(
@@ -442,12 +434,9 @@ def test_signal_figure_is_notebook_06s_figure_3_from_one_result() -> None:
     by_object = run.signal_figure()
     noisier = bias_model.track_with_input(DEFAULT, bias=DEFAULT_BIAS, sigma_a=400.0)
     other = noisier.signal_figure()
-    try:
-        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
-        assert plotting.figure_png(other) != plotting.figure_png(by_arrays)
-    finally:
-        for fig in (by_arrays, by_object, other):
-            plt.close(fig)
+    drawn, painted, another = pngs(by_object, by_arrays, other)
+    assert drawn == painted
+    assert another != painted
     with pytest.raises(ValueError, match="single run"):
         bias_model.track_with_input(DEFAULT, runs=2).signal_figure()
 
@@ -461,9 +450,7 @@ def _batches(biases: tuple[float, ...], sigmas: tuple[float, ...], runs: int = 3
 def test_settling_figure_is_notebook_06s_figure_6_from_the_runs() -> None:
     """``InputTracking.settling_figure(by_bias, by_sigma_v)`` draws what the notebook's
     arrays drew, pixel for pixel; other runs draw another figure."""
-    import matplotlib.pyplot as plt
-
-    from lqe_helpers import figures, plotting
+    from lqe_helpers import figures
 
     by_bias, by_sigma_v = _batches((-60.0, 20.0), (0.5, 4.5))
     by_arrays = figures.bias_settling_figure(
@@ -473,12 +460,9 @@ def test_settling_figure_is_notebook_06s_figure_6_from_the_runs() -> None:
         {f"σ_v = {s} cm": batch.bias_stds[0] for s, batch in by_sigma_v.items()})
     by_object = bias_model.InputTracking.settling_figure(by_bias, by_sigma_v)
     other = bias_model.InputTracking.settling_figure(*_batches((-60.0, 0.0), (0.5, 1.5)))
-    try:
-        assert plotting.figure_png(by_object) == plotting.figure_png(by_arrays)
-        assert plotting.figure_png(other) != plotting.figure_png(by_arrays)
-    finally:
-        for fig in (by_arrays, by_object, other):
-            plt.close(fig)
+    drawn, painted, another = pngs(by_object, by_arrays, other)
+    assert drawn == painted
+    assert another != painted
 
 
 @pytest.mark.parametrize(("change", "message"), [
